@@ -1,0 +1,41 @@
+// Eq. 1: Ashikhmin-Shirley MDF, sqrt((ex+1)(ey+1))/(2π) · hz^((ex·hx²+ey·hy²)/(hx²+hy²)).
+// Written from the projected components (DESIGN §8): hz^e = exp(½·e·log1p(-s²)),
+// so neither pow with a huge exponent nor 1 - hz² appears.
+#ifndef MDF_ASHIKHMIN_GLSL
+#define MDF_ASHIKHMIN_GLSL
+#include "lib/common.glsl"
+
+uniform float u_ex;
+uniform float u_ey;
+
+// -log1p(-s2)/s2: 1 at the pole, growing toward the rim. GLSL has no log1p,
+// and fp32 log(u) near u = 1 is only accurate in absolute terms, which at
+// exponents of 1e5-1e6 (lobes at s2 ~ 1e-5) costs percents. Near the pole the
+// series 1 + s2/2 + s2²/3 + ... (truncation < 1e-8 below s2 = 1/8) is used;
+// further out u - 1 is exact and log(u)/(u - 1) is accurate.
+float log1p_ratio(float s2) {
+    if (s2 < 0.125) {
+        float sum = 1.0 / 9.0;
+        sum = 1.0 / 8.0 + s2 * sum;
+        sum = 1.0 / 7.0 + s2 * sum;
+        sum = 1.0 / 6.0 + s2 * sum;
+        sum = 1.0 / 5.0 + s2 * sum;
+        sum = 1.0 / 4.0 + s2 * sum;
+        sum = 1.0 / 3.0 + s2 * sum;
+        sum = 1.0 / 2.0 + s2 * sum;
+        return 1.0 + s2 * sum;
+    }
+    float u = max(1.0 - s2, 1e-12);
+    return log(u) / (u - 1.0);
+}
+
+float mdf_ashikhmin(real2 h, float hz) {
+    float hx2 = float(h.x * h.x);
+    float hy2 = float(h.y * h.y);
+    float s2 = min(hx2 + hy2, 1.0);
+    float log_term = -0.5 * (u_ex * hx2 + u_ey * hy2) * log1p_ratio(s2);
+    float norm = sqrt((u_ex + 1.0) * (u_ey + 1.0)) / TWO_PI;
+    return hz > 0.0 ? norm * exp(log_term) : 0.0;
+}
+
+#endif

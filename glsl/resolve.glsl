@@ -1,0 +1,27 @@
+//! defines: TONEMAP_REINHARD TONEMAP_ACES TRANSPARENT
+// Averages the accumulated samples and encodes for display: exposure, tone map,
+// sRGB; composited over the background unless the output keeps its alpha.
+#include "fullscreen.glsl"
+
+#ifdef FRAGMENT_SHADER
+#include "lib/display.glsl"
+
+uniform sampler2D u_accum;
+uniform float u_inv_samples;
+uniform float u_exposure;
+uniform vec3 u_background;  // display-referred sRGB
+
+out vec4 frag_color;
+
+void main() {
+    vec4 acc = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0) * u_inv_samples;
+    float coverage = clamp(acc.a, 0.0, 1.0);
+    vec3 straight = coverage > 0.0 ? acc.rgb / coverage : vec3(0.0);
+    vec3 display = srgb_encode(tonemap(straight * u_exposure));
+#ifdef TRANSPARENT
+    frag_color = vec4(display, coverage);
+#else
+    frag_color = vec4(mix(u_background, display, coverage), 1.0);
+#endif
+}
+#endif

@@ -1,0 +1,102 @@
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC
+// A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
+// (coverage), accumulated over jittered samples by the renderer.
+
+#ifdef VERTEX_SHADER
+in vec3 in_position;
+in vec3 in_normal;
+in vec3 in_tangent;
+in vec2 in_uv;
+
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+uniform mat4 u_view_proj;
+uniform vec2 u_jitter;  // sub-pixel offset in NDC units
+
+out vec3 v_world;
+out vec3 v_object;
+out vec3 v_normal;
+out vec3 v_tangent;
+out vec2 v_uv;
+
+// The depth pre-pass and the shading pass must produce identical depths.
+invariant gl_Position;
+
+void main() {
+    vec4 world = u_model * vec4(in_position, 1.0);
+    v_world = world.xyz;
+    v_object = in_position;
+    v_normal = u_normal_matrix * in_normal;
+    v_tangent = mat3(u_model) * in_tangent;
+    v_uv = in_uv;
+    vec4 clip = u_view_proj * world;
+    clip.xy += u_jitter * clip.w;
+    gl_Position = clip;
+}
+#endif
+
+#ifdef FRAGMENT_SHADER
+#include "lib/reflectance.glsl"
+
+in vec3 v_world;
+in vec3 v_object;
+in vec3 v_normal;
+in vec3 v_tangent;
+in vec2 v_uv;
+
+uniform vec3 u_eye;
+uniform mat4 u_model;
+// xyz: position (w = 1, point light) or direction toward the light (w = 0).
+uniform vec4 u_light_position[LIGHT_COUNT];
+// Irradiance: at unit distance for point lights (falls off as 1/d²).
+uniform vec3 u_light_irradiance[LIGHT_COUNT];
+#ifdef DIFFUSE
+uniform vec3 u_ambient;
+#endif
+#ifdef NORMAL_MAP
+uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
+#endif
+
+out vec4 frag_color;
+
+vec3 tangent_field() {
+#ifdef TANGENT_CONCENTRIC
+    // Along the tracks of a disc lying in the object's xz plane: perpendicular
+    // to the radius, so the highlight strips curve as in the paper's Fig. 9.
+    return mat3(u_model) * vec3(-v_object.z, 0.0, v_object.x);
+#else
+    return v_tangent;
+#endif
+}
+
+void main() {
+    vec3 n = v_normal;
+    if (dot(n, n) < 1e-20) {
+        n = vec3(0.0, 1.0, 0.0);  // zero-area triangles can interpolate to nothing
+    }
+    vec3 t = tangent_field();
+#ifdef NORMAL_MAP
+    vec3 mapped = texture(u_normal_map, v_uv).xyz;
+    // A zero normal in the map keeps the geometric one.
+    if (dot(mapped, mapped) > 1e-12) {
+        n = shading_frame(n, t) * normalize(mapped);
+    }
+#endif
+    mat3 frame = shading_frame(n, t);
+    vec3 v = normalize(u_eye - v_world);
+
+    vec3 radiance = vec3(0.0);
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
+        vec4 light = u_light_position[i];
+        vec3 to_light = light.xyz - light.w * v_world;
+        float dist2 = max(dot(to_light, to_light), 1e-8);
+        vec3 l = to_light * inversesqrt(dist2);
+        float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
+        radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v);
+    }
+#ifdef DIFFUSE
+    radiance += u_ambient * u_kd * u_albedo;
+#endif
+    frag_color = vec4(radiance, 1.0);
+}
+#endif

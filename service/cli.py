@@ -1,0 +1,212 @@
+"""The ``opaline`` command: render presets, MDF plots, list presets, report the context."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from .params import Material, RenderRequest, describe_errors, field_range
+from .presets import PresetError, UnknownPreset, all_presets
+from .request import CostError, resolve
+
+TUPLE_FIELDS = {"albedo"}
+
+
+class CliError(Exception):
+    """A user error: printed as one line, exit status 2."""
+
+
+def parameter_help() -> str:
+    lines = ["parameters for --set NAME=VALUE (unset ones come from the preset):"]
+    for name, info in RenderRequest.model_fields.items():
+        if name == "preset":
+            continue
+        allowed = field_range(RenderRequest, name)
+        desc = (info.description or "").split(", -2π")[0]
+        lines.append(f"  {name:<16} {desc}" + (f" Range {allowed}." if allowed and allowed not in desc else ""))
+    return "\n".join(lines)
+
+
+def parse_sets(pairs: list[str]) -> dict[str, object]:
+    values: dict[str, object] = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        if not sep or not name:
+            raise CliError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set mu_f=8.5")
+        values[name.strip()] = value.split(",") if name.strip() in TUPLE_FIELDS else value
+    return values
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    try:
+        if "x" in text.lower():
+            w, h = text.lower().split("x")
+            return int(w), int(h)
+        return int(text), int(text)
+    except ValueError:
+        raise CliError(f"--size {text!r}: expected WxH or N, e.g. --size 512x256") from None
+
+
+def build_request(preset: str, sets: list[str], size: str | None, fmt: str | None, extra: dict) -> RenderRequest:
+    fields = parse_sets(sets)
+    if size:
+        fields["width"], fields["height"] = parse_size(size)
+    if fmt:
+        fields["format"] = fmt
+    fields.update({k: v for k, v in extra.items() if v is not None})
+    try:
+        return RenderRequest(preset=preset, **fields)
+    except ValidationError as exc:
+        raise CliError("; ".join(describe_errors(exc))) from None
+
+
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write to a temporary name beside the target, then rename: never a half-written file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as out:
+            out.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def cmd_render(args: argparse.Namespace) -> None:
+    from .pipeline import LocalRenderer
+
+    request = build_request(args.preset, args.set, args.size, args.format,
+                            {"quality": args.quality, "transparent": args.transparent or None})
+    with LocalRenderer(args.backend) as renderer:
+        data = renderer.render_bytes(request)
+    write_atomic(Path(args.output), data)
+
+
+def cmd_mdf(args: argparse.Namespace) -> None:
+    from .pipeline import LocalRenderer
+
+    fields = parse_sets(args.set)
+    wavelengths = int(fields.pop("wavelengths", 0) or 0)
+    try:
+        material = Material(**fields)
+    except ValidationError as exc:
+        raise CliError("; ".join(describe_errors(exc, Material))) from None
+    if not 16 <= args.size <= 2048:
+        raise CliError(f"--size={args.size} is out of range: allowed [16 … 2048]")
+    with LocalRenderer(args.backend) as renderer:
+        data = renderer.mdf_bytes(material, args.size, args.format, wavelengths)
+    write_atomic(Path(args.output), data)
+
+
+def cmd_presets(args: argparse.Namespace) -> None:
+    presets = all_presets()
+    if args.json:
+        print(json.dumps({n: p.model_dump(mode="json") for n, p in presets.items()}, indent=2))
+        return
+    for name, preset in presets.items():
+        job = resolve(RenderRequest(preset=name), preset)
+        m = job.material
+        params = (f"mdf={m.mdf} mu_f={m.mu_f:g} alpha={m.alpha:g} beta={m.beta:g}" if m.mdf == "multipeak"
+                  else f"mdf={m.mdf} ex={m.ex:g} ey={m.ey:g}")
+        print(f"{name:<18} {preset.description}")
+        print(f"{'':<18} {preset.figure}")
+        print(f"{'':<18} defaults: {params} theta1={m.theta1:.4g} theta2={m.theta2:.4g} "
+              f"kd={m.kd:g} ks={m.ks:g} f0={m.f0:g}")
+
+
+def cmd_info(args: argparse.Namespace) -> None:
+    from .context import create_context
+
+    gl = create_context(args.backend)
+    try:
+        info = gl.describe()
+    finally:
+        gl.release()
+    for key, value in info.items():
+        print(f"{key}: {value}")
+
+
+def add_common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--backend", choices=["egl", "osmesa", "auto"], default=None,
+                        help="headless GL backend (default: $OPALINE_GL_BACKEND or egl)")
+
+
+def make_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="opaline",
+        description="Headless previews of iridescent materials (Kang, Lee, Cho 2014).",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    fmt = argparse.RawDescriptionHelpFormatter
+
+    render = sub.add_parser("render", help="render a preset to an image file", epilog=parameter_help(),
+                            formatter_class=fmt)
+    render.add_argument("preset", help="preset name (see `opaline presets`)")
+    render.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a parameter; repeatable (albedo takes R,G,B)")
+    render.add_argument("--size", metavar="WxH", help="image size, each 16 … 2048 (default 256x256)")
+    render.add_argument("--format", choices=["png", "png16", "npy"], help="output format (default png)")
+    render.add_argument("--quality", choices=["draft", "standard", "high", "reference"],
+                        help="quality tier (default standard)")
+    render.add_argument("--transparent", action="store_true", help="transparent PNG background")
+    render.add_argument("-o", "--output", required=True, help="output file")
+    add_common(render)
+    render.set_defaults(func=cmd_render)
+
+    mdf = sub.add_parser("mdf", help="plot the MDF over the half-vector disc (Figs. 2, 3, 6, 7)",
+                         epilog=parameter_help(), formatter_class=fmt)
+    mdf.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                     help="material parameter; repeatable (mdf, ex, ey, mu_f, alpha, beta, theta1, "
+                          "theta2, wavelengths)")
+    mdf.add_argument("--size", type=int, default=256, help="plot size N (N×N), 16 … 2048")
+    mdf.add_argument("--format", choices=["png", "npy"], default="png",
+                     help="png (normalised, sRGB) or npy (linear D, float32)")
+    mdf.add_argument("-o", "--output", required=True, help="output file")
+    add_common(mdf)
+    mdf.set_defaults(func=cmd_mdf)
+
+    presets = sub.add_parser("presets", help="list presets with their descriptions and defaults")
+    presets.add_argument("--json", action="store_true", help="full preset data as JSON")
+    presets.set_defaults(func=cmd_presets)
+
+    info = sub.add_parser("info", help="report the GL backend and renderer Opaline gets")
+    add_common(info)
+    info.set_defaults(func=cmd_info)
+
+    from . import cli_extra
+
+    cli_extra.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = make_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except (CliError, PresetError, UnknownPreset, CostError) as exc:
+        print(f"opaline {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"opaline {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # context or shader failures: one line, non-zero
+        from .context import ContextError
+        from .shaders import ShaderError
+
+        if isinstance(exc, (ContextError, ShaderError)):
+            print(f"opaline {args.command}: error: {exc}", file=sys.stderr)
+            return 1
+        raise
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,179 @@
+"""Request parameters: the one place their names, ranges, defaults and docs live.
+
+DESIGN.md §3. The CLI's ``--help``, the HTTP API's OpenAPI schema, preset
+files and material files all read these models, so a range is written once.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+TWO_PI = 2.0 * math.pi
+
+MdfName = Literal["ashikhmin", "multipeak"]
+ImageFormat = Literal["png", "png16", "npy"]
+Tonemap = Literal["none", "reinhard", "aces"]
+Quality = Literal["draft", "standard", "high", "reference"]
+AntiAlias = Literal["none", "analytic"]
+
+Exponent = Annotated[float, Field(ge=0.0, le=1e6)]
+Frequency = Annotated[float, Field(ge=0.0, le=1000.0)]
+Anisotropy = Annotated[float, Field(ge=0.0, le=1000.0)]
+Angle = Annotated[float, Field(ge=-TWO_PI, le=TWO_PI)]
+Weight = Annotated[float, Field(ge=0.0, le=100.0)]
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+Pixels = Annotated[int, Field(ge=16, le=2048)]
+
+STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+def _wavelengths_ok(value: int | None) -> int | None:
+    if value is not None and value != 0 and not 3 <= value <= 128:
+        raise ValueError("must be 0 (the paper's RGB rotations) or 3 … 128")
+    return value
+
+
+class MaterialFields(BaseModel):
+    """Material parameters; ``None`` means "take the preset's value"."""
+
+    model_config = STRICT
+
+    mdf: MdfName | None = Field(None, description="Microfacet distribution: 'ashikhmin' (eq. 1) or 'multipeak' (eqs. 3-4).")
+    ex: Exponent | None = Field(None, description="Ashikhmin-Shirley exponent along the tangent (eq. 1), 0 … 1e6.")
+    ey: Exponent | None = Field(None, description="Ashikhmin-Shirley exponent along the bitangent (eq. 1), 0 … 1e6.")
+    mu_f: Frequency | None = Field(None, description="Multi-peak frequency: rings across the MDF disc (eq. 4), 0 … 1000.")
+    alpha: Anisotropy | None = Field(None, description="Multi-peak anisotropy along the tangent (eq. 4), 0 … 1000.")
+    beta: Anisotropy | None = Field(None, description="Multi-peak anisotropy along the bitangent (eq. 4), 0 … 1000.")
+    theta1: Angle | None = Field(None, description="Rotation of the green channel's MDF in radians (eq. 2), -2π … 2π.")
+    theta2: Angle | None = Field(None, description="Rotation of the blue channel's MDF in radians (eq. 2), -2π … 2π.")
+    kd: Weight | None = Field(None, description="Diffuse weight, 0 … 100.")
+    ks: Weight | None = Field(None, description="Specular weight, 0 … 100.")
+    albedo: tuple[Unit, Unit, Unit] | None = Field(None, description="Diffuse colour, linear RGB, each 0 … 1.")
+    f0: Unit | None = Field(None, description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off).")
+
+
+class RenderFields(MaterialFields):
+    """What a request (or a preset's defaults) may set besides the material."""
+
+    width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")
+    height: Pixels | None = Field(None, description="Image height in pixels, 16 … 2048.")
+    format: ImageFormat | None = Field(None, description="'png' (8-bit sRGB), 'png16' (16-bit sRGB) or 'npy' (linear float32 RGBA).")
+    transparent: bool | None = Field(None, description="PNG with a transparent background instead of the preset's.")
+    quality: Quality | None = Field(None, description="Tier bundling samples, wavelengths and anti-aliasing: draft, standard, high, reference.")
+    samples: Annotated[int, Field(ge=1, le=1024)] | None = Field(None, description="Samples per pixel, 1 … 1024 (default: the tier's).")
+    wavelengths: int | None = Field(None, description="0 = the paper's RGB rotations, else 3 … 128 wavelengths integrated with CIE 1931 (default: the tier's).")
+    aa: AntiAlias | None = Field(None, description="'analytic' band-limits the multi-peak cosine by the pixel footprint; 'none' does not (default: the tier's).")
+    exposure: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(None, description="Linear exposure multiplier before tone mapping, (0, 1000].")
+    tonemap: Tonemap | None = Field(None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces'.")
+    light_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(None, description="Moves the key light: azimuth in degrees around the object's up axis, -360 … 360.")
+    light_elevation: Annotated[float, Field(ge=-90.0, le=90.0)] | None = Field(None, description="Moves the key light: elevation in degrees above the horizon, -90 … 90.")
+
+    @field_validator("wavelengths")
+    @classmethod
+    def _wavelengths_in_range(cls, value: int | None) -> int | None:
+        return _wavelengths_ok(value)
+
+
+class RenderRequest(RenderFields):
+    """A render request: a preset and any fields that override its defaults."""
+
+    preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
+
+
+class Material(BaseModel):
+    """A fully specified material, as the renderer consumes it."""
+
+    model_config = STRICT
+
+    mdf: MdfName = "multipeak"
+    ex: Exponent = 100.0
+    ey: Exponent = 10.0
+    mu_f: Frequency = 8.5
+    alpha: Anisotropy = 2.0
+    beta: Anisotropy = 1.2
+    theta1: Angle = 0.1
+    theta2: Angle = 0.2
+    kd: Weight = 0.0
+    ks: Weight = 1.0
+    albedo: tuple[Unit, Unit, Unit] = (0.5, 0.5, 0.5)
+    f0: Unit = 1.0
+
+
+MATERIAL_FIELDS = tuple(Material.model_fields)
+
+
+def field_range(model: type[BaseModel], name: str) -> str | None:
+    """The allowed range of a numeric field, as 'lo … hi', read from its constraints."""
+    info = model.model_fields.get(name)
+    if info is None:
+        return None
+    lo = hi = None
+    lo_open = hi_open = False
+    for meta in _constraints(info):
+        lo = getattr(meta, "ge", lo)
+        hi = getattr(meta, "le", hi)
+        if getattr(meta, "gt", None) is not None:
+            lo, lo_open = meta.gt, True
+        if getattr(meta, "lt", None) is not None:
+            hi, hi_open = meta.lt, True
+    if lo is None and hi is None:
+        return None
+    return f"{'(' if lo_open else '['}{_fmt(lo)} … {_fmt(hi)}{')' if hi_open else ']'}"
+
+
+def _constraints(info) -> list[Any]:
+    found = list(info.metadata)
+    annotation = info.annotation
+    for arg in getattr(annotation, "__args__", ()) or ():
+        found.extend(getattr(arg, "__metadata__", ()))
+        for inner in getattr(arg, "__args__", ()) or ():
+            found.extend(getattr(inner, "__metadata__", ()))
+    return [meta for item in found for meta in getattr(item, "metadata", [item])]
+
+
+def _fmt(value: float | None) -> str:
+    if value is None:
+        return "∞"
+    if isinstance(value, float) and abs(abs(value) - TWO_PI) < 1e-12:
+        return "-2π" if value < 0 else "2π"
+    if isinstance(value, float) and value.is_integer() and abs(value) < 1e7:
+        return str(int(value)) if abs(value) < 1e5 else f"{value:g}"
+    return f"{value:g}"
+
+
+def field_doc(model: type[BaseModel], name: str) -> str:
+    info = model.model_fields[name]
+    return info.description or ""
+
+
+RANGE_ERRORS = {"less_than_equal", "greater_than_equal", "less_than", "greater_than"}
+
+
+def describe_errors(exc: ValidationError, model: type[BaseModel] = RenderRequest) -> list[str]:
+    """One line per problem: the field, the value given, and what is allowed."""
+    lines = []
+    for err in exc.errors():
+        loc = [str(p) for p in err["loc"] if not isinstance(p, int) or len(err["loc"]) > 1]
+        name = str(err["loc"][0]) if err["loc"] else "request"
+        where = ".".join(loc) or name
+        given = err.get("input")
+        allowed = field_range(model, name)
+        if err["type"] == "extra_forbidden":
+            known = ", ".join(sorted(model.model_fields))
+            lines.append(f"{where}: unknown field (known fields: {known})")
+            continue
+        kind = err["type"]
+        if kind in RANGE_ERRORS and allowed:
+            text = f"{where}={given!r} is out of range: allowed {allowed}"
+        elif kind == "finite_number":
+            text = f"{where}={given!r} must be a finite number" + (f" in {allowed}" if allowed else "")
+        else:
+            msg = err["msg"].removeprefix("Value error, ")
+            text = f"{where}={given!r}: {msg}"
+            if allowed and kind != "literal_error":
+                text += f" (allowed {allowed})"
+        lines.append(text)
+    return lines

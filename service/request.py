@@ -1,0 +1,106 @@
+"""Request resolution: preset defaults, then the request's fields, then the tier.
+
+Produces a ``Job``: every value concrete, nothing optional, and a canonical
+JSON form whose hash (with the shader sources and the version) is the cache
+key for the encoded image.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict, dataclass
+
+from . import __version__
+from .params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
+from .presets import Preset, get_preset
+
+# What each quality tier means; a request may override any field of it.
+TIERS: dict[str, dict[str, object]] = {
+    "draft": {"samples": 1, "wavelengths": 0, "aa": "analytic"},
+    "standard": {"samples": 4, "wavelengths": 0, "aa": "analytic"},
+    "high": {"samples": 16, "wavelengths": 16, "aa": "analytic"},
+    "reference": {"samples": 256, "wavelengths": 64, "aa": "none"},
+}
+
+BASE_DEFAULTS = {
+    "width": 256,
+    "height": 256,
+    "format": "png",
+    "transparent": False,
+    "quality": "standard",
+    "exposure": 1.0,
+    "tonemap": "aces",
+}
+
+
+class CostError(ValueError):
+    """The request would cost more than the configured budget."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """A fully resolved render: what the renderer needs and nothing else."""
+
+    preset: str
+    material: Material
+    width: int
+    height: int
+    format: str
+    transparent: bool
+    quality: str
+    samples: int
+    wavelengths: int
+    aa: str
+    exposure: float
+    tonemap: str
+    light_azimuth: float | None
+    light_elevation: float | None
+
+    @property
+    def cost(self) -> int:
+        return self.width * self.height * self.samples * max(self.wavelengths, 3)
+
+    def canonical(self) -> dict:
+        data = asdict(self)
+        data["material"] = self.material.model_dump(mode="json")
+        return data
+
+    def cache_key(self, scene_key: str = "") -> str:
+        from .shaders import sources_digest
+
+        payload = json.dumps(
+            {"job": self.canonical(), "scene": scene_key, "shaders": sources_digest(),
+             "version": __version__},
+            sort_keys=True,
+        )
+        return hashlib.sha256(payload.encode()).hexdigest()[:32]
+
+
+def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None) -> Job:
+    """Merge built-in defaults, the preset's defaults and the request's fields."""
+    if preset is None:
+        preset = get_preset(getattr(request, "preset", "sphere"))
+    fields: dict = dict(BASE_DEFAULTS)
+    fields.update(preset.defaults.model_dump(exclude_none=True))
+    fields.update(request.model_dump(exclude_none=True, exclude={"preset"}))
+    tier = TIERS[fields["quality"]]
+    for name, value in tier.items():
+        fields.setdefault(name, value)
+    material = Material(**{k: fields.pop(k) for k in MATERIAL_FIELDS if k in fields})
+    return Job(
+        preset=preset.name,
+        material=material,
+        light_azimuth=fields.pop("light_azimuth", None),
+        light_elevation=fields.pop("light_elevation", None),
+        **fields,
+    )
+
+
+def check_cost(job: Job, budget: int) -> None:
+    if job.cost > budget:
+        raise CostError(
+            f"cost={job.cost} (width×height×samples×max(wavelengths, 3) = "
+            f"{job.width}×{job.height}×{job.samples}×{max(job.wavelengths, 3)}) is over the "
+            f"budget of {budget}: lower the size, samples or wavelengths"
+        )
