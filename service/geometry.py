@@ -199,17 +199,15 @@ def sphere(radius: float = 1.0, segments: int = 128, rings: int = 64) -> Mesh:
     south = first + (rings - 1) * cols
     j = np.arange(segments)
     # The grid (row i = colatitude, column j = longitude) has (b-a)×(c-a) =
-    # east × south = outward, so _grid_indices is counter-clockwise from outside.
-    body = first + _grid_indices(rings - 1, cols)
-    north_fan = np.stack([j, first + j + 1, first + j], 1)
-    south_fan = np.stack([last_row + j, last_row + j + 1, south + j], 1)
+    # east × south = inward, so every triangle swaps its last two corners.
+    body = first + _grid_indices(rings - 1, cols)[:, [0, 2, 1]]
+    north_fan = np.stack([j, first + j, first + j + 1], 1)
+    south_fan = np.stack([last_row + j, south + j, last_row + j + 1], 1)
     indices = np.concatenate([north_fan, body, south_fan])
     return _mesh(normals * radius, normals, tangents, uvs, indices)
 
 
-def annulus(
-    inner_radius: float, outer_radius: float, segments: int = 256, rings: int = 4
-) -> Mesh:
+def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings: int = 4) -> Mesh:
     """Flat ring in the xz plane facing +y, the disc of the paper's CD figure.
 
     The hole is real (no triangles inside ``inner_radius``) so nothing is shaded
@@ -220,9 +218,7 @@ def annulus(
     inner = _positive("inner_radius", inner_radius)
     outer = _positive("outer_radius", outer_radius)
     if inner >= outer:
-        raise ValueError(
-            f"argument 'inner_radius' must be < outer_radius ({outer}), got {inner}"
-        )
+        raise ValueError(f"argument 'inner_radius' must be < outer_radius ({outer}), got {inner}")
     segments = _int("segments", segments, *SEGMENTS)
     rings = _int("rings", rings, *RINGS)
 

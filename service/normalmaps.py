@@ -142,15 +142,19 @@ def nacre(
     ``tilt``, so neighbouring platelets catch the light at different angles and
     the iridescence breaks up into patches. Inside each, concentric sines
     around the site (``ripple_frequency`` rings per texture width, peak slope
-    ``ripple``, random phase per cell) imitate the growth lines.
+    ``ripple``, random phase per cell) imitate the growth lines. Rings finer
+    than ``resolution / 4`` are faded out, and gone at ``resolution / 2``.
     """
     resolution = _int("resolution", resolution, *RESOLUTION)
     seed = _int("seed", seed, *SEED)
     cells = _int("cells", cells, 1, 10_000)
     tilt = _real("tilt", tilt, 0.0, 100.0)
     ripple = _real("ripple", ripple, 0.0, 100.0)
-    # Beyond the Nyquist limit the rings would alias into a moiré.
-    ripple_frequency = _real("ripple_frequency", ripple_frequency, 0.0, resolution / 2)
+    ripple_frequency = _real("ripple_frequency", ripple_frequency, 0.0, 10_000.0)
+    # Rings finer than the texels can hold would alias into a moiré. Fade them
+    # out from a quarter to half the resolution (the Nyquist limit) instead, so
+    # a low-resolution preview keeps the platelets and just loses the fine lines.
+    ripple *= min(max(2.0 - 4.0 * ripple_frequency / resolution, 0.0), 1.0)
 
     rng = np.random.default_rng(seed)
     sites = rng.random((cells, 2))

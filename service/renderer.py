@@ -25,6 +25,7 @@ from .shaders import ProgramCache
 
 log = logging.getLogger(__name__)
 MAX_TARGET_SIZES = 4
+NORMAL_MAP_UNIT = 1
 
 
 @dataclass
@@ -169,10 +170,9 @@ class Renderer:
             "u_light_irradiance": [tuple(light.irradiance) for light in lights],
             "u_ambient": tuple(preset.ambient),
         })
-        uniforms.apply(program, values)
         if scene.normal_map is not None:
-            scene.normal_map.use(location=0)
-            program["u_normal_map"].value = 0
+            values["u_normal_map"] = NORMAL_MAP_UNIT
+        uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
         accumulate = self.programs.get("accumulate.glsl")
         multi = len(offsets) > 1
@@ -185,6 +185,9 @@ class Renderer:
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
             program["u_jitter"].value = (2.0 * dx / width, 2.0 * dy / height)
+            if scene.normal_map is not None:
+                # Rebound every sample: the accumulate pass below uses unit 0.
+                scene.normal_map.use(location=NORMAL_MAP_UNIT)
             vao.render(moderngl.TRIANGLES)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
