@@ -1,0 +1,43 @@
+"""Shared fixtures: one renderer per test session on the backend under test.
+
+The backend comes from OPALINE_GL_BACKEND (egl by default); scripts/test runs
+the GL tests a second time with OPALINE_GL_BACKEND=osmesa. Only one backend
+lives in a process: EGL and OSMesa share Mesa's GL dispatch.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from service.context import requested_backend
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "gl: needs a headless GL context (run on both backends)")
+
+
+@pytest.fixture(scope="session")
+def backend() -> str:
+    return requested_backend(os.environ.get("OPALINE_GL_BACKEND"))
+
+
+@pytest.fixture(scope="session")
+def renderer(backend):
+    from service.renderer import Renderer
+
+    r = Renderer(backend)
+    yield r
+    r.release()
+
+
+@pytest.fixture(scope="session")
+def local(renderer):
+    """A LocalRenderer sharing the session's context."""
+    from service.pipeline import LocalRenderer
+
+    local = LocalRenderer.__new__(LocalRenderer)
+    local.renderer = renderer
+    local.cost_budget = 2048 * 2048 * 64 * 3
+    return local
