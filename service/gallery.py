@@ -26,7 +26,7 @@ MDF_FIGURES: dict[str, dict[str, object]] = {
 
 
 def build_gallery(out: Path, size: int = 256, mdf_size: int = 256, backend: str | None = None,
-                  quality: str = "high") -> dict[str, list[str]]:
+                  quality: str = "standard") -> dict[str, list[str]]:
     from .cli import write_atomic
     from .pipeline import LocalRenderer
     from .presets import all_presets
@@ -57,6 +57,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", default="docs/gallery", help="output folder (default docs/gallery)")
     parser.add_argument("--size", type=int, default=256, help="preset image size (default 256)")
     parser.add_argument("--mdf-size", type=int, default=256, help="MDF plot size (default 256)")
-    parser.add_argument("--quality", default="high", choices=["draft", "standard", "high", "reference"])
+    parser.add_argument("--quality", default="standard", choices=["draft", "standard", "high", "reference"])
     parser.add_argument("--backend", choices=["egl", "osmesa", "auto"], default=None)
     parser.set_defaults(func=cmd_gallery)

@@ -99,6 +99,7 @@ class Renderer:
         self._targets: OrderedDict[tuple[int, int], Targets] = OrderedDict()
         self._scenes: dict[str, SceneGPU] = {}
         self._empty_vao: dict[int, moderngl.VertexArray] = {}
+        self._flat_normal: moderngl.Texture | None = None
 
     # Resources
 
@@ -116,6 +117,13 @@ class Renderer:
             self._scenes[key] = SceneGPU(self.ctx, preset)
         return self._scenes[key]
 
+    def flat_normal_map(self) -> moderngl.Texture:
+        """A 1×1 map of the unperturbed normal, for the all-features baseline."""
+        if self._flat_normal is None:
+            data = np.array([0.0, 0.0, 1.0], dtype="f4").tobytes()
+            self._flat_normal = self.ctx.texture((1, 1), 3, data, dtype="f4")
+        return self._flat_normal
+
     def fullscreen(self, program: moderngl.Program) -> None:
         vao = self._empty_vao.get(program.glo)
         if vao is None:
@@ -130,12 +138,14 @@ class Renderer:
 
     # Scenes
 
-    def render(self, job: Job, preset: Preset | None = None) -> Frame:
+    def render(self, job: Job, preset: Preset | None = None, all_features: bool = False) -> Frame:
+        """Draw a job. ``all_features`` compiles every optional feature in (with neutral
+        values) instead of the scene's own variant: the benchmark's baseline."""
         preset = preset or get_preset(job.preset)
         size = (job.width, job.height)
         targets = self.targets(size)
         offsets = sample_offsets(job.samples)
-        self._draw_samples(job, preset, targets, offsets)
+        self._draw_samples(job, preset, targets, offsets, all_features)
         source = targets.sample_tex if len(offsets) == 1 else targets.accum_tex
         if job.format == "npy":
             fbo = targets.sample_fbo if len(offsets) == 1 else targets.accum_fbo
@@ -151,10 +161,17 @@ class Renderer:
         defines["LIGHT_COUNT"] = len(preset.lights)
         return defines
 
-    def _draw_samples(self, job: Job, preset: Preset, targets: Targets, offsets: np.ndarray) -> None:
+    def _draw_samples(self, job: Job, preset: Preset, targets: Targets, offsets: np.ndarray,
+                      all_features: bool = False) -> None:
         ctx = self.ctx
-        program = self.programs.get("surface.glsl", self.surface_defines(job, preset))
+        defines = self.surface_defines(job, preset)
         scene = self.scene(preset)
+        normal_map = scene.normal_map
+        if all_features:
+            defines.update(DIFFUSE=True, FRESNEL=True, NORMAL_MAP=True)
+            defines["AA_ANALYTIC"] = job.material.mdf == "multipeak"
+            normal_map = normal_map or self.flat_normal_map()
+        program = self.programs.get("surface.glsl", defines)
         width, height = targets.size
         lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,
                                  job.light_elevation)
@@ -170,7 +187,7 @@ class Renderer:
             "u_light_irradiance": [tuple(light.irradiance) for light in lights],
             "u_ambient": tuple(preset.ambient),
         })
-        if scene.normal_map is not None:
+        if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
@@ -185,9 +202,9 @@ class Renderer:
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
             program["u_jitter"].value = (2.0 * dx / width, 2.0 * dy / height)
-            if scene.normal_map is not None:
+            if normal_map is not None:
                 # Rebound every sample: the accumulate pass below uses unit 0.
-                scene.normal_map.use(location=NORMAL_MAP_UNIT)
+                normal_map.use(location=NORMAL_MAP_UNIT)
             vao.render(moderngl.TRIANGLES)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
@@ -271,5 +288,7 @@ class Renderer:
             scene.release()
         for targets in self._targets.values():
             targets.release()
+        if self._flat_normal is not None:
+            self._flat_normal.release()
         self.programs.release()
         self.gl.release()
