@@ -117,8 +117,8 @@ def _grid_indices(rows: int, cols: int) -> np.ndarray:
 
     For vertices ``a=(i, j)``, ``b=(i, j+1)``, ``c=(i+1, j)``, ``d=(i+1, j+1)``
     the triangles are ``(a, b, c)`` and ``(b, d, c)``: counter-clockwise seen
-    from the side of ``(b - a) × (c - a)``. Callers lay out their grids so that
-    this cross product points along the normal.
+    from the side of ``(b - a) × (c - a)``. Where that points away from the
+    normal, callers swap the last two corners.
     """
     i, j = np.meshgrid(np.arange(rows - 1), np.arange(cols - 1), indexing="ij")
     a = (i * cols + j).ravel()
@@ -235,8 +235,8 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     tangents = np.stack([-z, zeros, x], 1) / rr[:, None]
     uvs = np.stack([(x / outer + 1.0) * 0.5, (z / outer + 1.0) * 0.5], 1)
 
-    # Row i = radius, column j = angle; (a, c, b) is counter-clockwise seen from
-    # +y because (angle direction) × (radial direction) = +y.
+    # Row i = radius, column j = angle: (b-a)×(c-a) = (angle direction) × (radial
+    # direction) = +y, so (a, b, c) and (b, d, c) are counter-clockwise from +y.
     i, j = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
     i, j = i.ravel(), j.ravel()
     jn = (j + 1) % segments

@@ -314,6 +314,19 @@ def test_box_faces_are_flat():
     assert len(set(face_normals)) == 6
 
 
+def test_box_faces_stand_upright():
+    """On the four side faces v points up (+y), so a texture stands upright; on the top face
+    v points to -z and on the bottom face to +z, as seen from outside with the front at +z."""
+    _, n, t, _, _ = _f64(geometry.box())
+    v = np.cross(n, t)
+    for f in range(6):
+        normal, up = n[4 * f], v[4 * f]
+        if normal[1] == 0.0:
+            np.testing.assert_array_equal(up, [0.0, 1.0, 0.0])
+        else:
+            np.testing.assert_array_equal(up, [0.0, 0.0, -normal[1]])
+
+
 def test_box_volume_and_area():
     """The box's signed volume and surface area are exactly those of the size given."""
     a, b, c = 1.0, 2.0, 3.0

@@ -151,6 +151,9 @@ def test_nacre_cells_differ():
     distinct, counts = np.unique(n.reshape(-1, 3), axis=0, return_counts=True)
     assert cells // 2 <= len(distinct) <= cells
     assert counts.max() < 0.25 * n.shape[0] * n.shape[1]
+    for slope in _slopes(distinct):
+        assert len(np.unique(slope)) >= cells // 2, "both slope components vary per cell"
+        assert slope.min() < 0.0 < slope.max(), "platelets tilt every way"
 
 
 def test_nacre_tilt_is_the_largest_slope():
