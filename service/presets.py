@@ -12,7 +12,6 @@ import hashlib
 import json
 import tomllib
 from functools import cache
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -85,10 +84,11 @@ class Preset(BaseModel):
 
 
 def presets_dir() -> Path:
+    """``presets/`` in a checkout, ``service/_presets`` when installed."""
     checkout = Path(__file__).resolve().parent.parent / "presets"
     if checkout.is_dir():
         return checkout
-    return Path(str(resources.files("service.presets")))
+    return Path(__file__).resolve().parent / "_presets"
 
 
 def load_preset_file(path: Path) -> Preset:

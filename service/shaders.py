@@ -15,7 +15,6 @@ import logging
 import re
 from collections.abc import Mapping
 from functools import cache
-from importlib import resources
 from pathlib import Path
 
 import moderngl
@@ -35,11 +34,11 @@ class ShaderError(RuntimeError):
 
 @cache
 def glsl_root() -> Path:
-    """The shader sources: ``glsl/`` in a checkout, ``service/glsl`` when installed."""
+    """The shader sources: ``glsl/`` in a checkout, ``service/_glsl`` when installed."""
     checkout = Path(__file__).resolve().parent.parent / "glsl"
     if (checkout / "lib").is_dir():
         return checkout
-    return Path(str(resources.files("service.glsl")))
+    return Path(__file__).resolve().parent / "_glsl"
 
 
 @cache
