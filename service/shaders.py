@@ -90,16 +90,19 @@ def compose(program: str, stage: str, defines: Defines) -> tuple[str, list[str]]
     return "\n".join(header + body) + "\n", files
 
 
-def annotate_log(message: str, files: list[str]) -> str:
-    """Replace Mesa/NVIDIA style 'N:L(C)' / 'N(L)' source numbers by file names."""
+# Driver logs locate errors as "SOURCE:LINE(COL)" (Mesa) or "SOURCE(LINE)" (NVIDIA).
+LOG_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\(\d+\)|\((\d+)\))")
 
-    def name(match: re.Match[str]) -> str:
+
+def annotate_log(message: str, files: list[str]) -> str:
+    """Replace the driver's source numbers by the file names of the ``#line`` table."""
+
+    def located(match: re.Match[str]) -> str:
         index = int(match.group(1))
         label = files[index] if index < len(files) else f"source {index}"
-        return f"{label}:{match.group(2)}"
+        return f"{label}:{match.group(2) or match.group(3)}"
 
-    return re.sub(r"\b(\d+):(\d+)\(\d+\)|\b(\d+)\((\d+)\)", lambda m: name(m) if m.group(1) else
-                  name(re.match(r"(\d+)\((\d+)\)", m.group(0))), message)
+    return LOG_LOCATION.sub(located, message)
 
 
 @cache
