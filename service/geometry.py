@@ -18,13 +18,13 @@ Conventions shared by all meshes, relied on by ``glsl/surface.glsl``:
 
 from __future__ import annotations
 
-import inspect
 import math
-import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+from . import generators
 
 TWO_PI = 2.0 * math.pi
 
@@ -130,22 +130,12 @@ def _grid_indices(rows: int, cols: int) -> np.ndarray:
 # -- argument checks ---------------------------------------------------------
 
 
-def _int(name: str, value, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value!r}")
-    if not lo <= value <= hi:
-        raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value}")
-    return int(value)
 
 
-def _real(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise ValueError(f"argument '{name}' must be a finite number, got {value!r}")
-    return float(value)
 
 
 def _positive(name: str, value) -> float:
-    value = _real(name, value)
+    value = generators.real(name, value)
     if value <= 0.0:
         raise ValueError(f"argument '{name}' must be > 0, got {value}")
     return value
@@ -173,8 +163,8 @@ def sphere(radius: float = 1.0, segments: int = 128, rings: int = 64) -> Mesh:
     right seen from outside, north up), ``v`` north, seam duplicated at u=0/1.
     """
     radius = _positive("radius", radius)
-    segments = _int("segments", segments, *SEGMENTS)
-    rings = _int("rings", rings, 2, RINGS[1])
+    segments = generators.integer("segments", segments, *SEGMENTS)
+    rings = generators.integer("rings", rings, 2, RINGS[1])
 
     # Body rows (excluding the poles): rings-1 parallels of segments+1 vertices.
     theta = np.linspace(0.0, math.pi, rings + 1)[1:-1]
@@ -219,8 +209,8 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     outer = _positive("outer_radius", outer_radius)
     if inner >= outer:
         raise ValueError(f"argument 'inner_radius' must be < outer_radius ({outer}), got {inner}")
-    segments = _int("segments", segments, *SEGMENTS)
-    rings = _int("rings", rings, *RINGS)
+    segments = generators.integer("segments", segments, *SEGMENTS)
+    rings = generators.integer("rings", rings, *RINGS)
 
     # Angular columns wrap around: the uv is planar, so no seam vertex is needed.
     r = np.linspace(inner, outer, rings + 1)
@@ -291,7 +281,7 @@ def _check_waves(waves) -> np.ndarray:
     rows = []
     for k, wave in enumerate(waves):
         wave = _sequence(f"waves[{k}]", wave, 4)
-        amplitude, wavelength, direction, phase = (_real(f"waves[{k}]", v) for v in wave)
+        amplitude, wavelength, direction, phase = (generators.real(f"waves[{k}]", v) for v in wave)
         if wavelength <= 0.0:
             raise ValueError(f"argument 'waves[{k}]' needs a wavelength > 0, got {wavelength}")
         rows.append((amplitude, wavelength, direction, phase))
@@ -333,7 +323,7 @@ def wavy_surface(
     (the top face of a box seen from above), so ``cross(n, t)`` is along +v.
     """
     size = _positive("size", size)
-    resolution = _int("resolution", resolution, *RESOLUTION)
+    resolution = generators.integer("resolution", resolution, *RESOLUTION)
     waves = _check_waves(waves)
 
     s = np.linspace(-0.5 * size, 0.5 * size, resolution)
@@ -367,23 +357,4 @@ def build(kind: str, **args) -> Mesh:
     ``ValueError`` naming the geometry and the argument, which the HTTP layer
     can pass on verbatim.
     """
-    factory = KINDS.get(kind)
-    if factory is None:
-        raise ValueError(f"unknown geometry {kind!r} (known: {', '.join(KINDS)})")
-    parameters = inspect.signature(factory).parameters
-    for name in args:
-        if name not in parameters:
-            raise ValueError(
-                f"geometry {kind!r}: unknown argument {name!r} (known: {', '.join(parameters)})"
-            )
-    missing = [
-        name
-        for name, p in parameters.items()
-        if p.default is inspect.Parameter.empty and name not in args
-    ]
-    if missing:
-        raise ValueError(f"geometry {kind!r}: missing argument {missing[0]!r}")
-    try:
-        return factory(**args)
-    except ValueError as error:
-        raise ValueError(f"geometry {kind!r}: {error}") from None
+    return generators.call("geometry", KINDS, kind, args)

@@ -19,14 +19,14 @@ seeded with ``seed``, drawn in a fixed order.
 
 from __future__ import annotations
 
-import inspect
 import math
-import numbers
 import os
 from collections.abc import Callable, Sequence
 
 import numpy as np
 from PIL import Image
+
+from . import generators
 
 RESOLUTION = (8, 8192)
 SEED = (0, 2**63 - 1)
@@ -35,20 +35,8 @@ SEED = (0, 2**63 - 1)
 _BUMP_PEAK = 3.0 * math.sqrt(3.0) / 8.0
 
 
-def _int(name: str, value, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value!r}")
-    if not lo <= value <= hi:
-        raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value}")
-    return int(value)
 
 
-def _real(name: str, value, lo: float, hi: float) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise ValueError(f"argument '{name}' must be a number from {lo} to {hi}, got {value!r}")
-    if not lo <= value <= hi:
-        raise ValueError(f"argument '{name}' must be a number from {lo} to {hi}, got {value}")
-    return float(value)
 
 
 def _from_gradient(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
@@ -92,18 +80,18 @@ def bumps(
     bumps look equally steep. ``strength`` is that steepest slope (1 = 45°);
     overlapping bumps add up and may be steeper. Bumps wrap around the edges.
     """
-    resolution = _int("resolution", resolution, *RESOLUTION)
-    seed = _int("seed", seed, *SEED)
-    count = _int("count", count, 0, 10_000)
+    resolution = generators.integer("resolution", resolution, *RESOLUTION)
+    seed = generators.integer("seed", seed, *SEED)
+    count = generators.integer("count", count, 0, 10_000)
     if isinstance(radius, str | bytes) or not isinstance(radius, Sequence | np.ndarray):
         raise ValueError(f"argument 'radius' must be a (min, max) pair, got {radius!r}")
     if len(radius) != 2:
         raise ValueError(f"argument 'radius' must be a (min, max) pair, got {len(radius)} values")
-    r_min = _real("radius", radius[0], 0.0, 0.5)
-    r_max = _real("radius", radius[1], 0.0, 0.5)
+    r_min = generators.real("radius", radius[0], 0.0, 0.5)
+    r_max = generators.real("radius", radius[1], 0.0, 0.5)
     if not 0.0 < r_min <= r_max < 0.5:
         raise ValueError(f"argument 'radius' needs 0 < min <= max < 0.5, got {tuple(radius)}")
-    strength = _real("strength", strength, 0.0, 100.0)
+    strength = generators.real("strength", strength, 0.0, 100.0)
 
     rng = np.random.default_rng(seed)
     centres = rng.random((count, 2))
@@ -145,12 +133,12 @@ def nacre(
     ``ripple``, random phase per cell) imitate the growth lines. Rings finer
     than ``resolution / 4`` are faded out, and gone at ``resolution / 2``.
     """
-    resolution = _int("resolution", resolution, *RESOLUTION)
-    seed = _int("seed", seed, *SEED)
-    cells = _int("cells", cells, 1, 10_000)
-    tilt = _real("tilt", tilt, 0.0, 100.0)
-    ripple = _real("ripple", ripple, 0.0, 100.0)
-    ripple_frequency = _real("ripple_frequency", ripple_frequency, 0.0, 10_000.0)
+    resolution = generators.integer("resolution", resolution, *RESOLUTION)
+    seed = generators.integer("seed", seed, *SEED)
+    cells = generators.integer("cells", cells, 1, 10_000)
+    tilt = generators.real("tilt", tilt, 0.0, 100.0)
+    ripple = generators.real("ripple", ripple, 0.0, 100.0)
+    ripple_frequency = generators.real("ripple_frequency", ripple_frequency, 0.0, 10_000.0)
     # Rings finer than the texels can hold would alias into a moiré. Fade them
     # out from a quarter to half the resolution (the Nyquist limit) instead, so
     # a low-resolution preview keeps the platelets and just loses the fine lines.
@@ -237,22 +225,4 @@ def build(kind: str, **args) -> np.ndarray | None:
     ``"none"`` gives ``None`` (no map). Like ``geometry.build``, every failure
     is a ``ValueError`` naming the map kind and the argument.
     """
-    factory = KINDS.get(kind)
-    if factory is None:
-        raise ValueError(f"unknown normal map {kind!r} (known: {', '.join(KINDS)})")
-    parameters = inspect.signature(factory).parameters
-    for name in args:
-        if name not in parameters:
-            known = f"known: {', '.join(parameters)}" if parameters else "it takes none"
-            raise ValueError(f"normal map {kind!r}: unknown argument {name!r} ({known})")
-    missing = [
-        name
-        for name, p in parameters.items()
-        if p.default is inspect.Parameter.empty and name not in args
-    ]
-    if missing:
-        raise ValueError(f"normal map {kind!r}: missing argument {missing[0]!r}")
-    try:
-        return factory(**args)
-    except ValueError as error:
-        raise ValueError(f"normal map {kind!r}: {error}") from None
+    return generators.call("normal map", KINDS, kind, args)
