@@ -43,9 +43,15 @@ def measure(backend: str, repeats: int) -> dict:
                 encode_frame(frame, "png")
                 draw.append(middle - start)
                 encode.append(time.perf_counter() - middle)
-            rows.append({"preset": name, "size": size, "samples": job.samples,
-                         "draw_readback_ms": 1e3 * statistics.median(draw),
-                         "png_encode_ms": 1e3 * statistics.median(encode)})
+            rows.append(
+                {
+                    "preset": name,
+                    "size": size,
+                    "samples": job.samples,
+                    "draw_readback_ms": 1e3 * statistics.median(draw),
+                    "png_encode_ms": 1e3 * statistics.median(encode),
+                }
+            )
     info = renderer.gl.describe()
     renderer.release()
     return {"backend": backend, "renderer": info["renderer"], "rows": rows}
@@ -84,8 +90,12 @@ def main() -> None:
         return
     results = []
     for backend in args.backends:
-        out = subprocess.run([sys.executable, __file__, "--child", backend, "--repeats",
-                              str(args.repeats)], check=True, capture_output=True, text=True)
+        out = subprocess.run(
+            [sys.executable, __file__, "--child", backend, "--repeats", str(args.repeats)],
+            check=True,
+            capture_output=True,
+            text=True,
+        )
         results.append(json.loads(out.stdout.strip().splitlines()[-1]))
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "render_speed.json").write_text(json.dumps(results, indent=2))

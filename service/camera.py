@@ -32,8 +32,10 @@ def model_matrix(rotation_deg: tuple[float, float, float]) -> np.ndarray:
 
 
 def place_key_light(
-    lights: list[Light], target: tuple[float, float, float],
-    azimuth_deg: float | None, elevation_deg: float | None,
+    lights: list[Light],
+    target: tuple[float, float, float],
+    azimuth_deg: float | None,
+    elevation_deg: float | None,
 ) -> list[Light]:
     """Move the first light to an azimuth/elevation around the target, keeping its distance."""
     if azimuth_deg is None and elevation_deg is None:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from .params import Material, RenderRequest, describe_errors, field_range
+from .params import Material, RenderFields, RenderRequest, describe_errors, field_range
 from .presets import PresetError, UnknownPreset, all_presets
 from .request import CostError, resolve
 
@@ -29,7 +29,10 @@ def parameter_help() -> str:
             continue
         allowed = field_range(RenderRequest, name)
         desc = (info.description or "").split(", -2π")[0]
-        lines.append(f"  {name:<16} {desc}" + (f" Range {allowed}." if allowed and allowed not in desc else ""))
+        lines.append(
+            f"  {name:<16} {desc}"
+            + (f" Range {allowed}." if allowed and allowed not in desc else "")
+        )
     return "\n".join(lines)
 
 
@@ -53,7 +56,9 @@ def parse_size(text: str) -> tuple[int, int]:
         raise CliError(f"--size {text!r}: expected WxH or N, e.g. --size 512x256") from None
 
 
-def build_request(preset: str, sets: list[str], size: str | None, fmt: str | None, extra: dict) -> RenderRequest:
+def build_request(
+    preset: str, sets: list[str], size: str | None, fmt: str | None, extra: dict
+) -> RenderRequest:
     fields = parse_sets(sets)
     if size:
         fields["width"], fields["height"] = parse_size(size)
@@ -89,8 +94,13 @@ def _umask() -> int:
 def cmd_render(args: argparse.Namespace) -> None:
     from .pipeline import LocalRenderer
 
-    request = build_request(args.preset, args.set, args.size, args.format,
-                            {"quality": args.quality, "transparent": args.transparent or None})
+    request = build_request(
+        args.preset,
+        args.set,
+        args.size,
+        args.format,
+        {"quality": args.quality, "transparent": args.transparent or None},
+    )
     with LocalRenderer(args.backend) as renderer:
         data = renderer.render_bytes(request)
     write_atomic(Path(args.output), data)
@@ -100,11 +110,11 @@ def cmd_mdf(args: argparse.Namespace) -> None:
     from .pipeline import LocalRenderer
 
     fields = parse_sets(args.set)
-    wavelengths = int(fields.pop("wavelengths", 0) or 0)
     try:
+        wavelengths = RenderFields(wavelengths=fields.pop("wavelengths", 0)).wavelengths or 0
         material = Material(**fields)
     except ValidationError as exc:
-        raise CliError("; ".join(describe_errors(exc, Material))) from None
+        raise CliError("; ".join(describe_errors(exc, RenderFields))) from None
     if not 16 <= args.size <= 2048:
         raise CliError(f"--size={args.size} is out of range: allowed [16 … 2048]")
     with LocalRenderer(args.backend) as renderer:
@@ -120,12 +130,17 @@ def cmd_presets(args: argparse.Namespace) -> None:
     for name, preset in presets.items():
         job = resolve(RenderRequest(preset=name), preset)
         m = job.material
-        params = (f"mdf={m.mdf} mu_f={m.mu_f:g} alpha={m.alpha:g} beta={m.beta:g}" if m.mdf == "multipeak"
-                  else f"mdf={m.mdf} ex={m.ex:g} ey={m.ey:g}")
+        params = (
+            f"mdf={m.mdf} mu_f={m.mu_f:g} alpha={m.alpha:g} beta={m.beta:g}"
+            if m.mdf == "multipeak"
+            else f"mdf={m.mdf} ex={m.ex:g} ey={m.ey:g}"
+        )
         print(f"{name:<18} {preset.description}")
         print(f"{'':<18} {preset.figure}")
-        print(f"{'':<18} defaults: {params} theta1={m.theta1:.4g} theta2={m.theta2:.4g} "
-              f"kd={m.kd:g} ks={m.ks:g} f0={m.f0:g}")
+        print(
+            f"{'':<18} defaults: {params} theta1={m.theta1:.4g} theta2={m.theta2:.4g} "
+            f"kd={m.kd:g} ks={m.ks:g} f0={m.f0:g}"
+        )
 
 
 def cmd_info(args: argparse.Namespace) -> None:
@@ -141,8 +156,12 @@ def cmd_info(args: argparse.Namespace) -> None:
 
 
 def add_common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--backend", choices=["egl", "osmesa", "auto"], default=None,
-                        help="headless GL backend (default: $OPALINE_GL_BACKEND or egl)")
+    parser.add_argument(
+        "--backend",
+        choices=["egl", "osmesa", "auto"],
+        default=None,
+        help="headless GL backend (default: $OPALINE_GL_BACKEND or egl)",
+    )
 
 
 def make_parser() -> argparse.ArgumentParser:
@@ -153,28 +172,57 @@ def make_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     fmt = argparse.RawDescriptionHelpFormatter
 
-    render = sub.add_parser("render", help="render a preset to an image file", epilog=parameter_help(),
-                            formatter_class=fmt)
+    render = sub.add_parser(
+        "render",
+        help="render a preset to an image file",
+        epilog=parameter_help(),
+        formatter_class=fmt,
+    )
     render.add_argument("preset", help="preset name (see `opaline presets`)")
-    render.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a parameter; repeatable (albedo takes R,G,B)")
-    render.add_argument("--size", metavar="WxH", help="image size, each 16 … 2048 (default 256x256)")
-    render.add_argument("--format", choices=["png", "png16", "npy"], help="output format (default png)")
-    render.add_argument("--quality", choices=["draft", "standard", "high", "reference"],
-                        help="quality tier (default standard)")
+    render.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="override a parameter; repeatable (albedo takes R,G,B)",
+    )
+    render.add_argument(
+        "--size", metavar="WxH", help="image size, each 16 … 2048 (default 256x256)"
+    )
+    render.add_argument(
+        "--format", choices=["png", "png16", "npy"], help="output format (default png)"
+    )
+    render.add_argument(
+        "--quality",
+        choices=["draft", "standard", "high", "reference"],
+        help="quality tier (default standard)",
+    )
     render.add_argument("--transparent", action="store_true", help="transparent PNG background")
     render.add_argument("-o", "--output", required=True, help="output file")
     add_common(render)
     render.set_defaults(func=cmd_render)
 
-    mdf = sub.add_parser("mdf", help="plot the MDF over the half-vector disc (Figs. 2, 3, 6, 7)",
-                         epilog=parameter_help(), formatter_class=fmt)
-    mdf.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                     help="material parameter; repeatable (mdf, ex, ey, mu_f, alpha, beta, theta1, "
-                          "theta2, wavelengths)")
+    mdf = sub.add_parser(
+        "mdf",
+        help="plot the MDF over the half-vector disc (Figs. 2, 3, 6, 7)",
+        epilog=parameter_help(),
+        formatter_class=fmt,
+    )
+    mdf.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="material parameter; repeatable (mdf, ex, ey, mu_f, alpha, beta, theta1, "
+        "theta2, wavelengths)",
+    )
     mdf.add_argument("--size", type=int, default=256, help="plot size N (N×N), 16 … 2048")
-    mdf.add_argument("--format", choices=["png", "npy"], default="png",
-                     help="png (normalised, sRGB) or npy (linear D, float32)")
+    mdf.add_argument(
+        "--format",
+        choices=["png", "npy"],
+        default="png",
+        help="png (normalised, sRGB) or npy (linear D, float32)",
+    )
     mdf.add_argument("-o", "--output", required=True, help="output file")
     add_common(mdf)
     mdf.set_defaults(func=cmd_mdf)

@@ -53,7 +53,15 @@ class GLContext:
             "version": self.version,
         }
 
+    def make_current(self) -> None:
+        """Bind this context to the calling thread. Several contexts may share a thread
+        (tests, a CLI that opens two), so every entry point binds its own first."""
+        self.ctx.__enter__()
+
     def release(self) -> None:
+        # Unbind first: a context that is still current is only destroyed later,
+        # and would stay bound under whatever context the thread uses next.
+        self.ctx.__exit__(None, None, None)
         self.ctx.release()
         if self._loader is not None:
             self._loader.release()
@@ -63,9 +71,7 @@ class GLContext:
 def requested_backend(explicit: str | None = None) -> str:
     name = (explicit or os.environ.get("OPALINE_GL_BACKEND") or "egl").strip().lower()
     if name not in BACKENDS:
-        raise ContextError(
-            f"backend={name!r} is not known: choose one of {', '.join(BACKENDS)}"
-        )
+        raise ContextError(f"backend={name!r} is not known: choose one of {', '.join(BACKENDS)}")
     return name
 
 

@@ -37,7 +37,9 @@ def png16(display: np.ndarray, alpha: bool) -> bytes:
     channels = 4 if alpha else 3
     data = quantise(display[..., :channels], 16).astype(">u2")
     height, width = data.shape[:2]
-    rows = np.concatenate([np.zeros((height, 1), np.uint8), data.view(np.uint8).reshape(height, -1)], 1)
+    rows = np.concatenate(
+        [np.zeros((height, 1), np.uint8), data.view(np.uint8).reshape(height, -1)], 1
+    )
 
     def chunk(kind: bytes, payload: bytes) -> bytes:
         body = kind + payload
@@ -45,9 +47,13 @@ def png16(display: np.ndarray, alpha: bool) -> bytes:
 
     colour_type = 6 if alpha else 2
     header = struct.pack(">IIBBBBB", width, height, 16, colour_type, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
-            + chunk(b"sRGB", b"\x00")
-            + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6)) + chunk(b"IEND", b""))
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"sRGB", b"\x00")
+        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
+        + chunk(b"IEND", b"")
+    )
 
 
 def npy(array: np.ndarray) -> bytes:

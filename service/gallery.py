@@ -11,10 +11,34 @@ from .params import Material, RenderRequest
 # The paper's MDF figures. Figs. 2, 6, 7 are single-channel (no rotation);
 # Figs. 3 and 8 rotate G and B.
 MDF_FIGURES: dict[str, dict[str, object]] = {
-    "fig2a-ashikhmin-ex100-ey10": {"mdf": "ashikhmin", "ex": 100, "ey": 10, "theta1": 0, "theta2": 0},
-    "fig2b-ashikhmin-ex10-ey100": {"mdf": "ashikhmin", "ex": 10, "ey": 100, "theta1": 0, "theta2": 0},
-    "fig3a-ashikhmin-rotated": {"mdf": "ashikhmin", "ex": 100, "ey": 10, "theta1": 0.2, "theta2": 0.4},
-    "fig3b-ashikhmin-rotated": {"mdf": "ashikhmin", "ex": 10, "ey": 100, "theta1": 0.2, "theta2": 0.4},
+    "fig2a-ashikhmin-ex100-ey10": {
+        "mdf": "ashikhmin",
+        "ex": 100,
+        "ey": 10,
+        "theta1": 0,
+        "theta2": 0,
+    },
+    "fig2b-ashikhmin-ex10-ey100": {
+        "mdf": "ashikhmin",
+        "ex": 10,
+        "ey": 100,
+        "theta1": 0,
+        "theta2": 0,
+    },
+    "fig3a-ashikhmin-rotated": {
+        "mdf": "ashikhmin",
+        "ex": 100,
+        "ey": 10,
+        "theta1": 0.2,
+        "theta2": 0.4,
+    },
+    "fig3b-ashikhmin-rotated": {
+        "mdf": "ashikhmin",
+        "ex": 10,
+        "ey": 100,
+        "theta1": 0.2,
+        "theta2": 0.4,
+    },
     "fig6a-multipeak-mu2": {"mu_f": 2, "alpha": 1, "beta": 1, "theta1": 0, "theta2": 0},
     "fig6b-multipeak-mu5": {"mu_f": 5, "alpha": 1, "beta": 1, "theta1": 0, "theta2": 0},
     "fig6c-multipeak-mu10": {"mu_f": 10, "alpha": 1, "beta": 1, "theta1": 0, "theta2": 0},
@@ -25,8 +49,13 @@ MDF_FIGURES: dict[str, dict[str, object]] = {
 }
 
 
-def build_gallery(out: Path, size: int = 256, mdf_size: int = 256, backend: str | None = None,
-                  quality: str = "standard") -> dict[str, list[str]]:
+def build_gallery(
+    out: Path,
+    size: int = 256,
+    mdf_size: int = 256,
+    backend: str | None = None,
+    quality: str = "standard",
+) -> dict[str, list[str]]:
     from .cli import write_atomic
     from .pipeline import LocalRenderer
     from .presets import all_presets
@@ -49,14 +78,22 @@ def build_gallery(out: Path, size: int = 256, mdf_size: int = 256, backend: str 
 
 def cmd_gallery(args: argparse.Namespace) -> None:
     written = build_gallery(Path(args.out), args.size, args.mdf_size, args.backend, args.quality)
-    print(f"wrote {len(written['presets'])} preset images and {len(written['mdf'])} MDF plots to {args.out}")
+    print(
+        f"wrote {len(written['presets'])} preset images and {len(written['mdf'])} MDF plots to {args.out}"
+    )
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    parser = sub.add_parser("gallery", help="render every preset and the paper's MDF figures (README pictures)")
-    parser.add_argument("--out", default="docs/gallery", help="output folder (default docs/gallery)")
+    parser = sub.add_parser(
+        "gallery", help="render every preset and the paper's MDF figures (README pictures)"
+    )
+    parser.add_argument(
+        "--out", default="docs/gallery", help="output folder (default docs/gallery)"
+    )
     parser.add_argument("--size", type=int, default=256, help="preset image size (default 256)")
     parser.add_argument("--mdf-size", type=int, default=256, help="MDF plot size (default 256)")
-    parser.add_argument("--quality", default="standard", choices=["draft", "standard", "high", "reference"])
+    parser.add_argument(
+        "--quality", default="standard", choices=["draft", "standard", "high", "reference"]
+    )
     parser.add_argument("--backend", choices=["egl", "osmesa", "auto"], default=None)
     parser.set_defaults(func=cmd_gallery)

@@ -52,7 +52,11 @@ class OSMesaLoader:
         lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int), ctypes.c_void_p]
         lib.OSMesaMakeCurrent.restype = ctypes.c_ubyte
         lib.OSMesaMakeCurrent.argtypes = [
-            ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_int,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_uint,
+            ctypes.c_int,
+            ctypes.c_int,
         ]
         lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
         lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
@@ -60,12 +64,18 @@ class OSMesaLoader:
         self._lib = lib
 
         attribs = [
-            OSMESA_FORMAT, GL_RGBA,
-            OSMESA_DEPTH_BITS, 24,
-            OSMESA_STENCIL_BITS, 0,
-            OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-            OSMESA_CONTEXT_MAJOR_VERSION, major,
-            OSMESA_CONTEXT_MINOR_VERSION, minor,
+            OSMESA_FORMAT,
+            GL_RGBA,
+            OSMESA_DEPTH_BITS,
+            24,
+            OSMESA_STENCIL_BITS,
+            0,
+            OSMESA_PROFILE,
+            OSMESA_CORE_PROFILE,
+            OSMESA_CONTEXT_MAJOR_VERSION,
+            major,
+            OSMESA_CONTEXT_MINOR_VERSION,
+            minor,
             0,
         ]
         self._ctx = lib.OSMesaCreateContextAttribs((ctypes.c_int * len(attribs))(*attribs), None)
@@ -77,6 +87,15 @@ class OSMesaLoader:
         if not lib.OSMesaMakeCurrent(self._ctx, self._buffer, GL_UNSIGNED_BYTE, 1, 1):
             lib.OSMesaDestroyContext(self._ctx)
             raise OSMesaUnavailable("OSMesaMakeCurrent failed")
+
+    def __enter__(self) -> OSMesaLoader:
+        """Make this context current (moderngl's Context.__enter__ calls this)."""
+        if self._ctx:
+            self._lib.OSMesaMakeCurrent(self._ctx, self._buffer, GL_UNSIGNED_BYTE, 1, 1)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._lib.OSMesaMakeCurrent(None, None, 0, 0, 0)
 
     def load_opengl_function(self, name: str) -> int:
         return self._lib.OSMesaGetProcAddress(name.encode()) or 0

@@ -41,18 +41,38 @@ class MaterialFields(BaseModel):
 
     model_config = STRICT
 
-    mdf: MdfName | None = Field(None, description="Microfacet distribution: 'ashikhmin' (eq. 1) or 'multipeak' (eqs. 3-4).")
-    ex: Exponent | None = Field(None, description="Ashikhmin-Shirley exponent along the tangent (eq. 1), 0 … 1e6.")
-    ey: Exponent | None = Field(None, description="Ashikhmin-Shirley exponent along the bitangent (eq. 1), 0 … 1e6.")
-    mu_f: Frequency | None = Field(None, description="Multi-peak frequency: rings across the MDF disc (eq. 4), 0 … 1000.")
-    alpha: Anisotropy | None = Field(None, description="Multi-peak anisotropy along the tangent (eq. 4), 0 … 1000.")
-    beta: Anisotropy | None = Field(None, description="Multi-peak anisotropy along the bitangent (eq. 4), 0 … 1000.")
-    theta1: Angle | None = Field(None, description="Rotation of the green channel's MDF in radians (eq. 2), -2π … 2π.")
-    theta2: Angle | None = Field(None, description="Rotation of the blue channel's MDF in radians (eq. 2), -2π … 2π.")
+    mdf: MdfName | None = Field(
+        None, description="Microfacet distribution: 'ashikhmin' (eq. 1) or 'multipeak' (eqs. 3-4)."
+    )
+    ex: Exponent | None = Field(
+        None, description="Ashikhmin-Shirley exponent along the tangent (eq. 1), 0 … 1e6."
+    )
+    ey: Exponent | None = Field(
+        None, description="Ashikhmin-Shirley exponent along the bitangent (eq. 1), 0 … 1e6."
+    )
+    mu_f: Frequency | None = Field(
+        None, description="Multi-peak frequency: rings across the MDF disc (eq. 4), 0 … 1000."
+    )
+    alpha: Anisotropy | None = Field(
+        None, description="Multi-peak anisotropy along the tangent (eq. 4), 0 … 1000."
+    )
+    beta: Anisotropy | None = Field(
+        None, description="Multi-peak anisotropy along the bitangent (eq. 4), 0 … 1000."
+    )
+    theta1: Angle | None = Field(
+        None, description="Rotation of the green channel's MDF in radians (eq. 2), -2π … 2π."
+    )
+    theta2: Angle | None = Field(
+        None, description="Rotation of the blue channel's MDF in radians (eq. 2), -2π … 2π."
+    )
     kd: Weight | None = Field(None, description="Diffuse weight, 0 … 100.")
     ks: Weight | None = Field(None, description="Specular weight, 0 … 100.")
-    albedo: tuple[Unit, Unit, Unit] | None = Field(None, description="Diffuse colour, linear RGB, each 0 … 1.")
-    f0: Unit | None = Field(None, description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off).")
+    albedo: tuple[Unit, Unit, Unit] | None = Field(
+        None, description="Diffuse colour, linear RGB, each 0 … 1."
+    )
+    f0: Unit | None = Field(
+        None, description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off)."
+    )
 
 
 class RenderFields(MaterialFields):
@@ -60,16 +80,43 @@ class RenderFields(MaterialFields):
 
     width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")
     height: Pixels | None = Field(None, description="Image height in pixels, 16 … 2048.")
-    format: ImageFormat | None = Field(None, description="'png' (8-bit sRGB), 'png16' (16-bit sRGB) or 'npy' (linear float32 RGBA).")
-    transparent: bool | None = Field(None, description="PNG with a transparent background instead of the preset's.")
-    quality: Quality | None = Field(None, description="Tier bundling samples, wavelengths and anti-aliasing: draft, standard, high, reference.")
-    samples: Annotated[int, Field(ge=1, le=1024)] | None = Field(None, description="Samples per pixel, 1 … 1024 (default: the tier's).")
-    wavelengths: int | None = Field(None, description="0 = the paper's RGB rotations, else 3 … 128 wavelengths integrated with CIE 1931 (default: the tier's).")
-    aa: AntiAlias | None = Field(None, description="'analytic' band-limits the multi-peak cosine by the pixel footprint; 'none' does not (default: the tier's).")
-    exposure: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(None, description="Linear exposure multiplier before tone mapping, (0, 1000].")
-    tonemap: Tonemap | None = Field(None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces'.")
-    light_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(None, description="Moves the key light: azimuth in degrees around the object's up axis, -360 … 360.")
-    light_elevation: Annotated[float, Field(ge=-90.0, le=90.0)] | None = Field(None, description="Moves the key light: elevation in degrees above the horizon, -90 … 90.")
+    format: ImageFormat | None = Field(
+        None,
+        description="'png' (8-bit sRGB), 'png16' (16-bit sRGB) or 'npy' (linear float32 RGBA).",
+    )
+    transparent: bool | None = Field(
+        None, description="PNG with a transparent background instead of the preset's."
+    )
+    quality: Quality | None = Field(
+        None,
+        description="Tier bundling samples, wavelengths and anti-aliasing: draft, standard, high, reference.",
+    )
+    samples: Annotated[int, Field(ge=1, le=1024)] | None = Field(
+        None, description="Samples per pixel, 1 … 1024 (default: the tier's)."
+    )
+    # Bounds for UIs live in the schema; the validator gives the exact rule (0 or 3 … 128).
+    wavelengths: int | None = Field(
+        None,
+        json_schema_extra={"minimum": 0, "maximum": 128},
+        description="0 = the paper's RGB rotations, else 3 … 128 wavelengths integrated with CIE 1931 (default: the tier's).",
+    )
+    aa: AntiAlias | None = Field(
+        None,
+        description="'analytic' band-limits the multi-peak cosine by the pixel footprint; 'none' does not (default: the tier's).",
+    )
+    exposure: Annotated[float, Field(gt=0.0, le=1000.0)] | None = Field(
+        None, description="Linear exposure multiplier before tone mapping, (0, 1000]."
+    )
+    tonemap: Tonemap | None = Field(
+        None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces'."
+    )
+    light_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
+        None,
+        description="Moves the key light: azimuth in degrees around the object's up axis, -360 … 360.",
+    )
+    light_elevation: Annotated[float, Field(ge=-90.0, le=90.0)] | None = Field(
+        None, description="Moves the key light: elevation in degrees above the horizon, -90 … 90."
+    )
 
     @field_validator("wavelengths")
     @classmethod
@@ -152,28 +199,54 @@ def field_doc(model: type[BaseModel], name: str) -> str:
 RANGE_ERRORS = {"less_than_equal", "greater_than_equal", "less_than", "greater_than"}
 
 
+def _nested_model(annotation: Any) -> type[BaseModel] | None:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()) or ():
+        found = _nested_model(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def _owner(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel], str]:
+    """The (possibly nested) model that owns the last named field of an error location."""
+    owner, name = model, "request"
+    current: type[BaseModel] | None = model
+    for part in loc:
+        if isinstance(part, int) or current is None:
+            continue
+        owner, name = current, str(part)
+        info = current.model_fields.get(name)
+        current = _nested_model(info.annotation) if info is not None else None
+    return owner, name
+
+
 def describe_errors(exc: ValidationError, model: type[BaseModel] = RenderRequest) -> list[str]:
     """One line per problem: the field, the value given, and what is allowed."""
     lines = []
     for err in exc.errors():
         loc = [str(p) for p in err["loc"] if not isinstance(p, int) or len(err["loc"]) > 1]
-        name = str(err["loc"][0]) if err["loc"] else "request"
+        owner, name = _owner(model, tuple(err["loc"]))
         where = ".".join(loc) or name
         given = err.get("input")
-        allowed = field_range(model, name)
-        if err["type"] == "extra_forbidden":
-            known = ", ".join(sorted(model.model_fields))
-            lines.append(f"{where}: unknown field (known fields: {known})")
-            continue
+        allowed = field_range(owner, name)
         kind = err["type"]
-        if kind in RANGE_ERRORS and allowed:
-            text = f"{where}={given!r} is out of range: allowed {allowed}"
+        if kind == "extra_forbidden":
+            known = ", ".join(sorted(owner.model_fields))
+            lines.append(f"{where}: unknown field (known fields: {known})")
+        elif kind == "missing":
+            lines.append(f"{where}: required field missing")
+        elif kind in RANGE_ERRORS and allowed:
+            lines.append(f"{where}={given!r} is out of range: allowed {allowed}")
         elif kind == "finite_number":
-            text = f"{where}={given!r} must be a finite number" + (f" in {allowed}" if allowed else "")
+            lines.append(
+                f"{where}={given!r} must be a finite number" + (f" in {allowed}" if allowed else "")
+            )
         else:
             msg = err["msg"].removeprefix("Value error, ")
             text = f"{where}={given!r}: {msg}"
             if allowed and kind != "literal_error":
                 text += f" (allowed {allowed})"
-        lines.append(text)
+            lines.append(text)
     return lines

@@ -65,6 +65,8 @@ class LocalRenderer:
     def mdf_plot(self, material: Material, size: int, wavelengths: int = 0) -> np.ndarray:
         return self.renderer.mdf_plot(material, size, wavelengths)
 
-    def mdf_bytes(self, material: Material, size: int, fmt: str = "png", wavelengths: int = 0) -> bytes:
+    def mdf_bytes(
+        self, material: Material, size: int, fmt: str = "png", wavelengths: int = 0
+    ) -> bytes:
         plot = self.mdf_plot(material, size, wavelengths)
         return npy(plot) if fmt == "npy" else png8(mdf_display(plot), alpha=False)

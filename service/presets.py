@@ -21,7 +21,9 @@ from .params import RenderFields, describe_errors
 
 Vec3 = tuple[float, float, float]
 NonNegative3 = tuple[
-    Annotated[float, Field(ge=0.0)], Annotated[float, Field(ge=0.0)], Annotated[float, Field(ge=0.0)]
+    Annotated[float, Field(ge=0.0)],
+    Annotated[float, Field(ge=0.0)],
+    Annotated[float, Field(ge=0.0)],
 ]
 Colour = tuple[
     Annotated[float, Field(ge=0.0, le=1.0)],

@@ -58,7 +58,9 @@ def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint):
     r = np.sqrt(alpha * hx * hx + beta * hy * hy)
     x = TWO_PI * mu_f * r
     half = 0.5 * np.asarray(footprint, dtype=np.float64)
-    sinc = np.where(half > 1e-4, np.sin(half) / np.where(half > 1e-4, half, 1.0), 1.0 - half * half / 6.0)
+    sinc = np.where(
+        half > 1e-4, np.sin(half) / np.where(half > 1e-4, half, 1.0), 1.0 - half * half / 6.0
+    )
     return 0.5 * np.maximum(hz, 0.0) * (np.cos(x) * sinc + 1.0)
 
 
@@ -156,6 +158,7 @@ def mdf_plot(material, size, wavelengths=0):
 
 
 # Display encoding (glsl/lib/display.glsl)
+
 
 def tonemap(x, mode):
     x = np.maximum(x, 0.0)

@@ -50,8 +50,15 @@ class Targets:
         self.display_fbo = ctx.framebuffer([self.display_tex])
 
     def release(self) -> None:
-        for obj in (self.sample_fbo, self.accum_fbo, self.display_fbo, self.sample_tex,
-                    self.depth, self.accum_tex, self.display_tex):
+        for obj in (
+            self.sample_fbo,
+            self.accum_fbo,
+            self.display_fbo,
+            self.sample_tex,
+            self.depth,
+            self.accum_tex,
+            self.display_tex,
+        ):
             obj.release()
 
 
@@ -141,6 +148,7 @@ class Renderer:
     def render(self, job: Job, preset: Preset | None = None, all_features: bool = False) -> Frame:
         """Draw a job. ``all_features`` compiles every optional feature in (with neutral
         values) instead of the scene's own variant: the benchmark's baseline."""
+        self.gl.make_current()
         preset = preset or get_preset(job.preset)
         size = (job.width, job.height)
         targets = self.targets(size)
@@ -161,8 +169,14 @@ class Renderer:
         defines["LIGHT_COUNT"] = len(preset.lights)
         return defines
 
-    def _draw_samples(self, job: Job, preset: Preset, targets: Targets, offsets: np.ndarray,
-                      all_features: bool = False) -> None:
+    def _draw_samples(
+        self,
+        job: Job,
+        preset: Preset,
+        targets: Targets,
+        offsets: np.ndarray,
+        all_features: bool = False,
+    ) -> None:
         ctx = self.ctx
         defines = self.surface_defines(job, preset)
         scene = self.scene(preset)
@@ -173,20 +187,24 @@ class Renderer:
             normal_map = normal_map or self.flat_normal_map()
         program = self.programs.get("surface.glsl", defines)
         width, height = targets.size
-        lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,
-                                 job.light_elevation)
+        lights = place_key_light(
+            preset.lights, preset.camera.target, job.light_azimuth, job.light_elevation
+        )
         model = model_matrix(preset.rotation_deg)
         values = uniforms.material_uniforms(job.material, job.wavelengths)
-        values.update({
-            "u_model": model.astype("f4"),
-            "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
-            "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
-            "u_eye": tuple(preset.camera.eye),
-            "u_light_position": [(*light.position, 1.0 if light.type == "point" else 0.0)
-                                 for light in lights],
-            "u_light_irradiance": [tuple(light.irradiance) for light in lights],
-            "u_ambient": tuple(preset.ambient),
-        })
+        values.update(
+            {
+                "u_model": model.astype("f4"),
+                "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
+                "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
+                "u_eye": tuple(preset.camera.eye),
+                "u_light_position": [
+                    (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights
+                ],
+                "u_light_irradiance": [tuple(light.irradiance) for light in lights],
+                "u_ambient": tuple(preset.ambient),
+            }
+        )
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
         uniforms.apply(program, values)
@@ -216,8 +234,9 @@ class Renderer:
                 self.fullscreen(accumulate)
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
 
-    def _resolve(self, job: Job, preset: Preset, source: moderngl.Texture, targets: Targets,
-                 count: int) -> None:
+    def _resolve(
+        self, job: Job, preset: Preset, source: moderngl.Texture, targets: Targets, count: int
+    ) -> None:
         defines = {
             "TONEMAP_REINHARD": job.tonemap == "reinhard",
             "TONEMAP_ACES": job.tonemap == "aces",
@@ -226,21 +245,28 @@ class Renderer:
         program = self.programs.get("resolve.glsl", defines)
         targets.display_fbo.use()
         source.use(location=0)
-        uniforms.apply(program, {
-            "u_accum": 0,
-            "u_inv_samples": 1.0 / count,
-            "u_exposure": job.exposure,
-            "u_background": tuple(preset.background),
-        })
+        uniforms.apply(
+            program,
+            {
+                "u_accum": 0,
+                "u_inv_samples": 1.0 / count,
+                "u_exposure": job.exposure,
+                "u_background": tuple(preset.background),
+            },
+        )
         self.fullscreen(program)
 
     # Plots and probes
 
-    def mdf_plot(self, material: Material, size: int, wavelengths: int = 0,
-                 aa: str = "none") -> np.ndarray:
+    def mdf_plot(
+        self, material: Material, size: int, wavelengths: int = 0, aa: str = "none"
+    ) -> np.ndarray:
         """The MDF over the projected half-vector disc, (size, size, 3) linear float32."""
+        self.gl.make_current()
         defines = uniforms.material_defines(material, wavelengths, aa)
-        defines = {k: defines[k] for k in ("MDF_MULTIPEAK", "MDF_ASHIKHMIN", "WAVELENGTHS", "AA_ANALYTIC")}
+        defines = {
+            k: defines[k] for k in ("MDF_MULTIPEAK", "MDF_ASHIKHMIN", "WAVELENGTHS", "AA_ANALYTIC")
+        }
         defines["PRECISE_PHASE"] = self.gl.has_fp64
         program = self.programs.get("mdf_plot.glsl", defines)
         targets = self.targets((size, size))
@@ -251,9 +277,17 @@ class Renderer:
         self.fullscreen(program)
         return self.read(targets.display_fbo, (size, size))[..., :3]
 
-    def probe(self, material: Material, n: np.ndarray, t: np.ndarray, l: np.ndarray,
-              v: np.ndarray, wavelengths: int = 0) -> np.ndarray:
+    def probe(
+        self,
+        material: Material,
+        n: np.ndarray,
+        t: np.ndarray,
+        l: np.ndarray,
+        v: np.ndarray,
+        wavelengths: int = 0,
+    ) -> np.ndarray:
         """Reflected radiance for each (n, t, l, v) case through the surface shading code."""
+        self.gl.make_current()
         count = len(n)
         width = min(count, 256)
         height = -(-count // width)
@@ -282,6 +316,7 @@ class Renderer:
         return out
 
     def release(self) -> None:
+        self.gl.make_current()
         for vao in self._empty_vao.values():
             vao.release()
         for scene in self._scenes.values():

@@ -71,8 +71,12 @@ class Job:
         from .shaders import sources_digest
 
         payload = json.dumps(
-            {"job": self.canonical(), "scene": scene_key, "shaders": sources_digest(),
-             "version": __version__},
+            {
+                "job": self.canonical(),
+                "scene": scene_key,
+                "shaders": sources_digest(),
+                "version": __version__,
+            },
             sort_keys=True,
         )
         return hashlib.sha256(payload.encode()).hexdigest()[:32]

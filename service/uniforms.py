@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import moderngl
+import numpy as np
 
 from .params import Material
 from .spectrum import rgb_weights, rotation_at, sample_wavelengths
 
 
-def material_defines(material: Material, wavelengths: int = 0, aa: str = "none") -> dict[str, int | bool]:
+def material_defines(
+    material: Material, wavelengths: int = 0, aa: str = "none"
+) -> dict[str, int | bool]:
     """Only the features this material uses (DESIGN §2, "model only what a scene requires")."""
     multipeak = material.mdf == "multipeak"
     return {

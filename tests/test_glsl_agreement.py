@@ -109,11 +109,16 @@ def test_shading_matches_reference(renderer, seed):
     rng = np.random.default_rng(seed)
     material = Material(
         mdf="ashikhmin" if seed % 2 else "multipeak",
-        ex=float(10 ** rng.uniform(0, 3)), ey=float(10 ** rng.uniform(0, 3)),
-        mu_f=float(rng.uniform(0, 20)), alpha=float(rng.uniform(0, 5)),
-        beta=float(rng.uniform(0, 5)), theta1=float(rng.uniform(-1, 1)),
-        theta2=float(rng.uniform(-1, 1)), kd=float(rng.uniform(0, 1)),
-        ks=float(rng.uniform(0, 2)), albedo=tuple(rng.uniform(0, 1, 3)),
+        ex=float(10 ** rng.uniform(0, 3)),
+        ey=float(10 ** rng.uniform(0, 3)),
+        mu_f=float(rng.uniform(0, 20)),
+        alpha=float(rng.uniform(0, 5)),
+        beta=float(rng.uniform(0, 5)),
+        theta1=float(rng.uniform(-1, 1)),
+        theta2=float(rng.uniform(-1, 1)),
+        kd=float(rng.uniform(0, 1)),
+        ks=float(rng.uniform(0, 2)),
+        albedo=tuple(rng.uniform(0, 1, 3)),
         f0=float(rng.choice([1.0, rng.uniform(0, 1)])),
     )
     n, t, l, v = shading_cases(rng, 1000)

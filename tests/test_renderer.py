@@ -58,8 +58,12 @@ def test_many_samples_converge_to_one_sample(renderer, name):
     Catches state leaking between samples (once, the accumulate pass's texture
     was read back as the normal map from the second sample on).
     """
-    one = renderer.render(job_for(name, width=128, height=128, samples=1, format="npy", aa="analytic")).linear
-    many = renderer.render(job_for(name, width=128, height=128, samples=16, format="npy", aa="analytic")).linear
+    one = renderer.render(
+        job_for(name, width=128, height=128, samples=1, format="npy", aa="analytic")
+    ).linear
+    many = renderer.render(
+        job_for(name, width=128, height=128, samples=16, format="npy", aa="analytic")
+    ).linear
     inside = (one[..., 3] > 0.99) & (many[..., 3] > 0.99)
     diff = np.abs(one[..., :3] - many[..., :3])[inside]
     scale = float(many[..., :3][inside].mean())
@@ -85,10 +89,30 @@ def test_opaque_png_background_is_the_presets(local):
 
 def test_light_direction_override_moves_the_highlight(renderer):
     """light_azimuth moves the key light, so the sphere's brightest point moves too."""
-    left = renderer.render(job_for("sphere", width=64, height=64, format="npy", light_azimuth=180,
-                                   light_elevation=10, kd=0, mu_f=0)).linear
-    right = renderer.render(job_for("sphere", width=64, height=64, format="npy", light_azimuth=0,
-                                    light_elevation=10, kd=0, mu_f=0)).linear
+    left = renderer.render(
+        job_for(
+            "sphere",
+            width=64,
+            height=64,
+            format="npy",
+            light_azimuth=180,
+            light_elevation=10,
+            kd=0,
+            mu_f=0,
+        )
+    ).linear
+    right = renderer.render(
+        job_for(
+            "sphere",
+            width=64,
+            height=64,
+            format="npy",
+            light_azimuth=0,
+            light_elevation=10,
+            kd=0,
+            mu_f=0,
+        )
+    ).linear
     col_left = np.unravel_index(left[..., :3].sum(-1).argmax(), (64, 64))[1]
     col_right = np.unravel_index(right[..., :3].sum(-1).argmax(), (64, 64))[1]
     assert col_left < 32 < col_right
