@@ -31,6 +31,23 @@ def model_matrix(rotation_deg: tuple[float, float, float]) -> np.ndarray:
     return np.asarray(rotation)
 
 
+def _key_offset(light: Light, target) -> np.ndarray:
+    centre = np.asarray(target, dtype=np.float64) if light.type == "point" else 0.0
+    return np.asarray(light.position, dtype=np.float64) - centre
+
+
+def key_light_direction(lights: list[Light], target) -> dict[str, float] | None:
+    """Where the first light sits, in the degrees light_azimuth/light_elevation use."""
+    if not lights:
+        return None
+    offset = _key_offset(lights[0], target)
+    radius = float(np.linalg.norm(offset)) or 1.0
+    return {
+        "azimuth": math.degrees(math.atan2(offset[2], offset[0])),
+        "elevation": math.degrees(math.asin(max(-1.0, min(1.0, offset[1] / radius)))),
+    }
+
+
 def place_key_light(
     lights: list[Light],
     target: tuple[float, float, float],
@@ -41,14 +58,12 @@ def place_key_light(
     if azimuth_deg is None and elevation_deg is None:
         return lights
     key = lights[0]
-    centre = np.asarray(target, dtype=np.float64)
-    offset = np.asarray(key.position, dtype=np.float64) - (centre if key.type == "point" else 0.0)
+    offset = _key_offset(key, target)
     radius = float(np.linalg.norm(offset)) or 1.0
-    current_az = math.degrees(math.atan2(offset[2], offset[0]))
-    current_el = math.degrees(math.asin(max(-1.0, min(1.0, offset[1] / radius))))
-    az = math.radians(current_az if azimuth_deg is None else azimuth_deg)
-    el = math.radians(current_el if elevation_deg is None else elevation_deg)
+    current = key_light_direction(lights, target)
+    az = math.radians(current["azimuth"] if azimuth_deg is None else azimuth_deg)
+    el = math.radians(current["elevation"] if elevation_deg is None else elevation_deg)
     direction = np.array([math.cos(el) * math.cos(az), math.sin(el), math.cos(el) * math.sin(az)])
-    position = direction * radius + (centre if key.type == "point" else 0.0)
+    position = direction * radius + (np.asarray(target) if key.type == "point" else 0.0)
     moved = key.model_copy(update={"position": tuple(float(x) for x in position)})
     return [moved, *lights[1:]]
