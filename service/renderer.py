@@ -293,6 +293,7 @@ class Renderer:
         height = -(-count // width)
         defines = uniforms.material_defines(material, wavelengths)
         defines.pop("AA_ANALYTIC")
+        defines["PRECISE_PHASE"] = self.gl.has_fp64
         program = self.programs.get("brdf_probe.glsl", defines)
         textures = []
         for unit, (name, data) in enumerate(

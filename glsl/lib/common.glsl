@@ -1,7 +1,9 @@
 // Shared constants and the `real` type.
-// `real` is double in the PRECISE_PHASE variant (the MDF plot): the multi-peak
-// phase mu_f·r reaches 3e4 cycles at the top of the ranges, and fp32 would lose
-// it to ~1e-3 cycles. Scenes use float; trig always runs in float.
+// `real` is double in the PRECISE_PHASE variant (the MDF plot and the BRDF
+// probe): the multi-peak phase mu_f·r reaches 3e4 cycles at the top of the
+// ranges, where fp32 loses ~1e-3 cycles in the phase and ~0.07 cycles in the
+// frame and half vector. Scenes use float (their pixel footprint there spans
+// many cycles); trig always runs in float.
 #ifndef COMMON_GLSL
 #define COMMON_GLSL
 
@@ -13,9 +15,13 @@
 #ifdef PRECISE_PHASE
 #define real double
 #define real2 dvec2
+#define real3 dvec3
+#define realmat3 dmat3
 #else
 #define real float
 #define real2 vec2
+#define real3 vec3
+#define realmat3 mat3
 #endif
 
 #endif

@@ -16,19 +16,19 @@ uniform float u_kd;
 uniform vec3 u_albedo;
 #endif
 
-vec3 specular(mat3 frame, vec3 l, vec3 v) {
-    vec3 sum_lv = l + v;
-    float len = length(sum_lv);
+vec3 specular(realmat3 frame, vec3 l, vec3 v) {
+    real3 sum_lv = real3(l) + real3(v);
+    real len = length(sum_lv);
     // l = -v: no half vector, no specular.
     if (len <= EPS_HALF) {
         return vec3(0.0);
     }
-    vec3 h = sum_lv / len;
-    vec3 hl = transpose(frame) * h;  // (h·t, h·b, h·n)
-    vec3 d = mdf_color(real2(hl.xy), hl.z);
-    float vh = dot(v, h);
-    float nl = dot(frame[2], l);
-    float nv = dot(frame[2], v);
+    real3 h = sum_lv / len;
+    real3 hl = transpose(frame) * h;  // (h·t, h·b, h·n)
+    vec3 d = mdf_color(hl.xy, float(hl.z));
+    float vh = float(dot(real3(v), h));
+    float nl = float(dot(frame[2], real3(l)));
+    float nv = float(dot(frame[2], real3(v)));
 #ifdef FRESNEL
     float f = fresnel_schlick(vh);
 #else
@@ -38,12 +38,12 @@ vec3 specular(mat3 frame, vec3 l, vec3 v) {
     return u_ks * d * (f / denom);
 }
 
-vec3 reflected_radiance(mat3 frame, vec3 l, vec3 v) {
+vec3 reflected_radiance(realmat3 frame, vec3 l, vec3 v) {
     vec3 f = specular(frame, l, v);
 #ifdef DIFFUSE
     f += u_kd * u_albedo / PI;
 #endif
-    return f * max(dot(frame[2], l), 0.0);
+    return f * max(float(dot(frame[2], real3(l))), 0.0);
 }
 
 #endif
