@@ -264,4 +264,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run the imported module's main, not this __main__ copy: sub-command modules raise
+    # service.cli.CliError, which a second copy of the class would not catch.
+    from service.cli import main as _main
+
+    sys.exit(_main())

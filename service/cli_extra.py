@@ -1,4 +1,4 @@
-"""Sub-commands added by later stages (serve, batch, schema, bench, gallery)."""
+"""Sub-commands that live in their own modules (gallery, serve, batch, schema)."""
 
 from __future__ import annotations
 
@@ -6,11 +6,7 @@ import argparse
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from . import gallery
+    from . import batch, gallery, materials, serve
 
-    gallery.register(sub)
-    from . import serve; serve.register(sub)  # noqa: E702, I001
-    from . import batch, materials
-
-    batch.register(sub)
-    materials.register(sub)
+    for module in (gallery, serve, batch, materials):
+        module.register(sub)

@@ -30,7 +30,7 @@ Pixels = Annotated[int, Field(ge=16, le=2048)]
 STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
 
-def _wavelengths_ok(value: int | None) -> int | None:
+def wavelengths_ok(value: int | None) -> int | None:
     if value is not None and value != 0 and not 3 <= value <= 128:
         raise ValueError("must be 0 (the paper's RGB rotations) or 3 … 128")
     return value
@@ -121,7 +121,7 @@ class RenderFields(MaterialFields):
     @field_validator("wavelengths")
     @classmethod
     def _wavelengths_in_range(cls, value: int | None) -> int | None:
-        return _wavelengths_ok(value)
+        return wavelengths_ok(value)
 
 
 class RenderRequest(RenderFields):
@@ -199,6 +199,14 @@ def field_doc(model: type[BaseModel], name: str) -> str:
 RANGE_ERRORS = {"less_than_equal", "greater_than_equal", "less_than", "greater_than"}
 
 
+def _tuple_length(model: type[BaseModel], name: str) -> int:
+    info = model.model_fields.get(name)
+    for arg in getattr(info.annotation, "__args__", ()) if info else ():
+        if getattr(arg, "__origin__", None) is tuple:
+            return len(arg.__args__)
+    return 0
+
+
 def _nested_model(annotation: Any) -> type[BaseModel] | None:
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
         return annotation
@@ -235,6 +243,8 @@ def describe_errors(exc: ValidationError, model: type[BaseModel] = RenderRequest
         if kind == "extra_forbidden":
             known = ", ".join(sorted(owner.model_fields))
             lines.append(f"{where}: unknown field (known fields: {known})")
+        elif kind == "missing" and isinstance(err["loc"][-1], int):
+            lines.append(f"{name}: expected {_tuple_length(owner, name)} values, got fewer")
         elif kind == "missing":
             lines.append(f"{where}: required field missing")
         elif kind in RANGE_ERRORS and allowed:

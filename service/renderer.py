@@ -182,8 +182,8 @@ class Renderer:
         scene = self.scene(preset)
         normal_map = scene.normal_map
         if all_features:
+            # AA stays as the job asks: it is a quality choice, not a scene feature.
             defines.update(DIFFUSE=True, FRESNEL=True, NORMAL_MAP=True)
-            defines["AA_ANALYTIC"] = job.material.mdf == "multipeak"
             normal_map = normal_map or self.flat_normal_map()
         program = self.programs.get("surface.glsl", defines)
         width, height = targets.size

@@ -1,0 +1,468 @@
+"""The HTTP API: thin routes over request → cache → render workers → response.
+
+    uvicorn --factory service.api:create_app      (or: opaline serve)
+
+Each route parses its input into the models of ``service.params``, resolves
+it to a ``Job`` (``service.request``), answers from the cache or through the
+worker pool (``service.worker``), and leaves every failure to the handlers
+of ``PUBLIC_ERRORS``, which give each a public face: 422 with one line per
+problem, 404 for an unknown preset, 413, 503 with Retry-After, 500 with an
+incident id (the traceback goes only to the server log).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+from contextlib import asynccontextmanager
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from fastapi import APIRouter, Depends, FastAPI, Query, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse, RedirectResponse, Response
+from fastapi.staticfiles import StaticFiles
+from pydantic import BaseModel, Field, ValidationError, field_validator
+from starlette.exceptions import HTTPException
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from . import __version__
+from .cache import ImageCache, etag, matches, mdf_key
+from .camera import key_light_direction
+from .encode import EXTENSIONS, MEDIA_TYPES
+from .metrics import Metrics
+from .params import (
+    MATERIAL_FIELDS,
+    Material,
+    MaterialFields,
+    Pixels,
+    RenderRequest,
+    Unit,
+    describe_errors,
+    wavelengths_ok,
+)
+from .presets import Preset, UnknownPreset, all_presets, get_preset
+from .renderer import Renderer
+from .request import TIERS, CostError, Job, check_cost, resolve
+from .settings import Settings, SettingsDep, get_settings
+from .spectrum import rgb_weights
+from .worker import (
+    DeadlineExceeded,
+    Overloaded,
+    RenderFailed,
+    Unavailable,
+    WorkerPool,
+    image_task,
+    mdf_task,
+)
+
+WEB_DIR = Path(__file__).resolve().parent / "web"
+MDF_LABEL = "mdf-plot"  # the render-latency label of MDF plots
+
+
+# Query-string forms of the request models
+
+
+def _comma_list(value: Any) -> Any:
+    """``albedo=0.1,0.2,0.3`` (or the parameter repeated three times) → three values."""
+    if isinstance(value, list) and len(value) == 1 and isinstance(value[0], str):
+        value = value[0]
+    return value.split(",") if isinstance(value, str) else value
+
+
+class RenderQuery(RenderRequest):
+    """A render request in a query string."""
+
+    albedo: tuple[Unit, Unit, Unit] | None = Field(
+        None, description="Diffuse colour, linear RGB, each 0 … 1, written R,G,B.")
+
+    _albedo = field_validator("albedo", mode="before")(_comma_list)
+
+
+class MdfQuery(MaterialFields):
+    """An MDF plot: the material, the plot size and format, the wavelength count."""
+
+    albedo: tuple[Unit, Unit, Unit] | None = Field(
+        None, description="Diffuse colour (unused by the plot), linear RGB, each 0 … 1, R,G,B.")
+    size: Pixels = Field(256, description="Plot size N (an N×N image), 16 … 2048.")
+    format: Literal["png", "npy"] = Field(
+        "png", description="'png' (normalised by the maximum, sRGB) or 'npy' (linear D, float32).")
+    wavelengths: int = Field(
+        0, description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
+
+    _albedo = field_validator("albedo", mode="before")(_comma_list)
+    _wavelengths = field_validator("wavelengths")(wavelengths_ok)
+
+
+class PresetInfo(BaseModel):
+    """A preset as the API shows it."""
+
+    name: str
+    description: str
+    figure: str
+    geometry: dict[str, Any] = Field(description="Geometry generator and its arguments.")
+    tangents: str
+    normal_map: dict[str, Any] | None
+    defaults: dict[str, Any] = Field(description="The fields the preset sets itself.")
+    resolved: dict[str, Any] = Field(
+        description="What a request naming only this preset renders: every value resolved.")
+    key_light: dict[str, float] | None = Field(
+        None, description="Where the preset puts its key light, in degrees, as light_azimuth "
+        "and light_elevation measure them.")
+
+
+class Problem(BaseModel):
+    detail: str
+
+
+class Problems(BaseModel):
+    detail: list[str] = Field(description="One line per problem: field, value, allowed range.")
+
+
+# Public errors
+
+
+class LimitError(ValueError):
+    """A request within the parameter ranges but over this service's configured limits."""
+
+    def __init__(self, problems: list[str]) -> None:
+        super().__init__("; ".join(problems))
+        self.problems = problems
+
+
+PUBLIC_ERRORS: dict[type[Exception], tuple[int, str | None]] = {
+    UnknownPreset: (404, "unknown_preset"),
+    CostError: (422, "cost"),
+    LimitError: (422, "invalid"),
+    ValidationError: (422, "invalid"),
+    Overloaded: (503, "queue_full"),
+    DeadlineExceeded: (503, "deadline"),
+    Unavailable: (503, "unavailable"),
+    RenderFailed: (500, None),
+}
+
+
+def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> list[str]:
+    """describe_errors' lines for FastAPI's errors, whose locations start with 'body'/'query'."""
+    lines, rest = [], []
+    for err in errors:
+        loc = tuple(err.get("loc", ()))
+        loc = loc[1:] if loc and loc[0] in ("body", "query", "path") else loc
+        if err["type"] == "json_invalid":
+            reason = (err.get("ctx") or {}).get("error", "")
+            lines.append(f"body: not valid JSON ({reason})" if reason else "body: not valid JSON")
+        elif not loc and err["type"] == "missing":
+            lines.append("body: a JSON object is required ({} renders the defaults)")
+        else:
+            rest.append({**err, "loc": () if loc and isinstance(loc[0], int) else loc})
+
+    class _Errors:  # the one method describe_errors reads from a ValidationError
+        @staticmethod
+        def errors() -> list[dict[str, Any]]:
+            return rest
+
+    return lines + describe_errors(_Errors(), model)  # type: ignore[arg-type]
+
+
+def _problem(status: int, detail: str | list[str], headers: dict[str, str] | None = None):
+    return JSONResponse({"detail": detail}, status_code=status, headers=headers)
+
+
+async def on_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
+    request.app.state.metrics.reject("invalid")
+    model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
+    return _problem(422, _validation_lines(list(exc.errors()), model))
+
+
+async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
+    status, reason = next(v for k, v in PUBLIC_ERRORS.items() if isinstance(exc, k))
+    state = request.app.state
+    if reason:
+        state.metrics.reject(reason)
+    if isinstance(exc, ValidationError):
+        return _problem(status, describe_errors(exc))
+    if isinstance(exc, LimitError):
+        return _problem(status, exc.problems)
+    if isinstance(exc, RenderFailed):
+        return _problem(status, f"{exc}: the details are in the server log")
+    if status == 503:
+        retry = str(state.settings.retry_after_s)
+        return _problem(status, f"{exc}; retry later", headers={"Retry-After": retry})
+    return _problem(status, [str(exc)] if status == 422 else str(exc))
+
+
+class BodyLimit:
+    """413 for a body over ``limit`` bytes: by its Content-Length, or counted as it arrives."""
+
+    def __init__(self, app: ASGIApp, limit: int, on_reject: Any) -> None:
+        self.app, self.limit, self.on_reject = app, limit, on_reject
+
+    def _refuse(self) -> HTTPException:
+        self.on_reject()
+        return HTTPException(413, f"request body over the {self.limit} byte limit")
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        declared = dict(scope["headers"]).get(b"content-length", b"")
+        if declared.isdigit() and int(declared) > self.limit:
+            exc = self._refuse()
+            await _problem(413, exc.detail)(scope, receive, send)
+            return
+        seen = 0
+
+        async def counted() -> Message:
+            nonlocal seen
+            message = await receive()
+            seen += len(message.get("body", b""))
+            if seen > self.limit:
+                raise self._refuse()  # FastAPI re-raises HTTPException from its body reader
+            return message
+
+        await self.app(scope, counted, send)
+
+
+# Services the routes depend on
+
+
+@dataclass
+class Service:
+    settings: Settings
+    pool: WorkerPool
+    cache: ImageCache
+    metrics: Metrics
+
+    @property
+    def wait_s(self) -> float:
+        return self.settings.deadline_s + self.settings.render_timeout_s
+
+
+def get_service(request: Request, settings: SettingsDep) -> Service:
+    state = request.app.state
+    return Service(settings, state.pool, state.cache, state.metrics)
+
+
+ServiceDep = Annotated[Service, Depends(get_service)]
+
+
+def check_limits(job: Job, settings: Settings) -> None:
+    problems = [
+        f"{name}={value} is out of range: allowed [16 … {limit}] on this service"
+        for name, value, limit in (("width", job.width, settings.max_width),
+                                   ("height", job.height, settings.max_height))
+        if value > limit
+    ]
+    if problems:
+        raise LimitError(problems)
+    check_cost(job, settings.cost_budget)
+
+
+def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
+    size = min(settings.max_width, settings.max_height)
+    if params.size > size:
+        raise LimitError([f"size={params.size} is out of range: allowed [16 … {size}] "
+                          "on this service"])
+    cost = params.size * params.size * max(params.wavelengths, 3)
+    if cost > settings.cost_budget:
+        raise CostError(f"cost={cost} (size²×max(wavelengths, 3)) is over the budget of "
+                        f"{settings.cost_budget}: lower the size or wavelengths")
+
+
+async def answer_image(svc: Service, request: Request, key: str, task: Any, label: str,
+                       fmt: str, filename: str) -> Response:
+    """The image under ``key``: 304, from the cache, or rendered by a worker."""
+    tag = etag(key, svc.pool.identity)
+    headers = {"ETag": tag}
+    if request.method == "GET":
+        headers["Cache-Control"] = f"public, max-age={svc.settings.cache_max_age_s}"
+        if matches(request.headers.get("if-none-match"), tag):
+            return Response(status_code=304, headers=headers)
+    data = svc.cache.get(key)
+    if data is not None:
+        svc.metrics.cache_hits.inc()
+    else:
+        svc.metrics.cache_misses.inc()
+        data = await svc.pool.render(key, task, label, timeout=svc.wait_s)
+    headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
+    return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
+
+
+async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
+    preset = get_preset(params.preset)
+    job = resolve(params, preset)
+    check_limits(job, svc.settings)
+    key = job.cache_key(preset.scene_key())
+    return await answer_image(svc, request, key, image_task(job, preset), preset.name,
+                              job.format, preset.name)
+
+
+# Routes
+
+IMAGE = {"schema": {"type": "string", "format": "binary"}}
+RETRY_AFTER = {"Retry-After": {"description": "Seconds to wait before retrying.",
+                               "schema": {"type": "integer"}}}
+ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
+    422: {"model": Problems, "description": "Invalid parameters, or over a configured limit."},
+    503: {"model": Problem, "description": "Overloaded or no GL context.", "headers": RETRY_AFTER},
+    500: {"model": Problem, "description": "The render failed (details in the server log)."},
+}
+CONDITIONAL: dict[int | str, dict[str, Any]] = {
+    304: {"description": "Not modified: If-None-Match matched the ETag."}}
+RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
+    200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}},
+    404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
+    413: {"model": Problem, "description": "Request body too large."},
+    **ERROR_RESPONSES,
+}
+MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
+    200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}},
+    **CONDITIONAL, **ERROR_RESPONSES,
+}
+router = APIRouter()
+
+
+@router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
+             summary="Render a preset with material overrides (JSON body)")
+async def render_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, body)
+
+
+@router.get("/v1/render", tags=["render"], response_class=Response,
+            responses={**RENDER_RESPONSES, **CONDITIONAL},
+            summary="Render a preset with material overrides (query string, for <img src>)")
+async def render_get(params: Annotated[RenderQuery, Query()], request: Request,
+                     svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, params)
+
+
+@router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
+            summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
+async def mdf_get(params: Annotated[MdfQuery, Query()], request: Request,
+                  svc: ServiceDep) -> Response:
+    check_mdf_limits(params, svc.settings)
+    material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
+    key = mdf_key(material, params.size, params.format, params.wavelengths)
+    task = mdf_task(material, params.size, params.format, params.wavelengths)
+    return await answer_image(svc, request, key, task, MDF_LABEL, params.format, "mdf")
+
+
+def preset_info(preset: Preset) -> PresetInfo:
+    data = preset.model_dump(mode="json")
+    return PresetInfo(
+        name=preset.name, description=preset.description, figure=preset.figure,
+        geometry=data["geometry"], tangents=preset.tangents, normal_map=data["normal_map"],
+        defaults=preset.defaults.model_dump(mode="json", exclude_none=True),
+        resolved=resolve(RenderRequest(preset=preset.name), preset).canonical(),
+        key_light=_rounded(key_light_direction(preset.lights, preset.camera.target)),
+    )
+
+
+def _rounded(direction: dict[str, float] | None) -> dict[str, float] | None:
+    return None if direction is None else {k: round(v, 1) for k, v in direction.items()}
+
+
+@router.get("/v1/presets", tags=["presets"], summary="Every preset with its defaults")
+async def presets_list() -> list[PresetInfo]:
+    return [preset_info(p) for p in all_presets().values()]
+
+
+@router.get("/v1/presets/{name}", tags=["presets"], summary="One preset with its defaults",
+            responses={404: {"model": Problem, "description": "Unknown preset."}})
+async def presets_one(name: str) -> PresetInfo:
+    return preset_info(get_preset(name))
+
+
+@router.get("/healthz", tags=["operations"], summary="The process is alive")
+async def healthz() -> dict[str, str]:
+    return {"status": "ok"}
+
+
+@router.get("/readyz", tags=["operations"], summary="A render worker has a live GL context",
+            responses={503: {"description": "No worker has a GL context."}})
+async def readyz(svc: ServiceDep) -> JSONResponse:
+    workers = svc.pool.status()
+    ready = next((w for w in workers if w["state"] == "ready"), None)
+    body = {"ready": ready is not None, "backend": (ready or {}).get("backend"),
+            "renderer": (ready or {}).get("renderer"), "queue_depth": svc.pool.depth(),
+            "workers": workers}
+    return JSONResponse(body, status_code=200 if ready else 503)
+
+
+@router.get("/metrics", tags=["operations"], summary="Prometheus metrics",
+            response_class=Response,
+            responses={200: {"content": {Metrics.content_type: {"schema": {"type": "string"}}}}})
+async def metrics_get(svc: ServiceDep) -> Response:
+    return Response(svc.metrics.exposition(), media_type=Metrics.content_type)
+
+
+# The app
+
+
+def warmup_task():
+    """Compile the default preset's shaders and load the CIE tables before the first request."""
+    job = resolve(RenderRequest(width=16, height=16, quality="draft"))
+    draw = image_task(job, get_preset(job.preset))
+
+    def run(renderer: Any) -> bytes:
+        rgb_weights(int(TIERS["high"]["wavelengths"]))
+        return draw(renderer)
+
+    return run
+
+
+def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:
+    """The web page at '/' when service/web/ has one; otherwise '/' leads to the docs."""
+    index = web_dir / "index.html"
+    if index.is_file():
+        app.mount("/static", StaticFiles(directory=web_dir), name="static")
+        app.add_api_route("/", lambda: FileResponse(index), include_in_schema=False)
+    else:
+        app.add_api_route("/", lambda: RedirectResponse("/docs"), include_in_schema=False)
+
+
+@asynccontextmanager
+async def lifespan(app: FastAPI):
+    all_presets()  # an invalid preset stops the start-up, naming the file and field
+    await asyncio.to_thread(app.state.pool.start)
+    try:
+        yield
+    finally:
+        await asyncio.to_thread(app.state.pool.stop)
+
+
+def create_app(settings: Settings | None = None,
+               renderer_factory: Callable[[], Any] | None = None) -> FastAPI:
+    """The service; its lifespan starts the render workers and stops them at shutdown.
+
+    ``renderer_factory`` (called on each worker thread) defaults to a ``Renderer``
+    on ``settings.gl_backend``; tests pass one that fails on purpose.
+    """
+    if settings is None:
+        settings = get_settings()
+    metrics = Metrics()
+    cache = ImageCache(settings.cache_bytes)
+    factory = renderer_factory or partial(Renderer, settings.gl_backend)
+    pool = WorkerPool(factory, workers=settings.workers,
+                      queue_size=settings.queue_size, deadline_s=settings.deadline_s,
+                      cache=cache, metrics=metrics,
+                      warmup=warmup_task() if settings.warmup else None)
+    metrics.watch(pool.depth, lambda: cache.size_bytes)
+    app = FastAPI(title="Opaline", version=__version__, lifespan=lifespan,
+                  description="Headless previews of iridescent materials "
+                              "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
+    app.state.settings, app.state.pool = settings, pool
+    app.state.cache, app.state.metrics = cache, metrics
+    app.dependency_overrides[get_settings] = lambda: settings
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
+                       on_reject=partial(metrics.reject, "too_large"))
+    app.add_exception_handler(RequestValidationError, on_invalid)
+    for exc_type in PUBLIC_ERRORS:
+        app.add_exception_handler(exc_type, on_public_error)
+    app.include_router(router)
+    mount_web(app)
+    return app

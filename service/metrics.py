@@ -1,0 +1,70 @@
+"""Prometheus metrics, on a registry of the app's own (never the global one).
+
+One ``Metrics`` per app, so two apps in one process (tests) do not share or
+collide on counters.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from prometheus_client import (
+    CONTENT_TYPE_LATEST,
+    CollectorRegistry,
+    Counter,
+    Gauge,
+    Histogram,
+    generate_latest,
+)
+
+# Render times on llvmpipe run from milliseconds (draft thumbnails) to tens of
+# seconds (reference tier at 2048²).
+RENDER_BUCKETS = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 30.0, 60.0)
+
+REJECT_REASONS = ("invalid", "unknown_preset", "cost", "too_large", "queue_full", "deadline",
+                  "unavailable")
+
+
+class Metrics:
+    """The service's instruments."""
+
+    content_type = CONTENT_TYPE_LATEST
+
+    def __init__(self) -> None:
+        self.registry = CollectorRegistry(auto_describe=True)
+        self.render_seconds = Histogram(
+            "opaline_render_seconds", "Time a worker spent rendering and encoding one image.",
+            ["preset"], buckets=RENDER_BUCKETS, registry=self.registry)
+        self.queue_depth = Gauge(
+            "opaline_queue_depth", "Jobs waiting for a render worker.", registry=self.registry)
+        self.cache_hits = Counter(
+            "opaline_cache_hits", "Image requests answered from the cache.",
+            registry=self.registry)
+        self.cache_misses = Counter(
+            "opaline_cache_misses", "Image requests that needed a render.",
+            registry=self.registry)
+        self.cache_bytes = Gauge(
+            "opaline_cache_bytes", "Bytes of encoded images held in the cache.",
+            registry=self.registry)
+        self.rejected = Counter(
+            "opaline_rejected_requests", "Requests refused, by reason.", ["reason"],
+            registry=self.registry)
+        self.render_failures = Counter(
+            "opaline_render_failures", "Renders that raised (answered 500).",
+            registry=self.registry)
+        self.context_restarts = Counter(
+            "opaline_context_restarts", "GL contexts released after a failure and made anew.",
+            registry=self.registry)
+        for reason in REJECT_REASONS:
+            self.rejected.labels(reason)
+
+    def watch(self, queue_depth: Callable[[], float], cache_bytes: Callable[[], float]) -> None:
+        """Read the gauges from their sources at scrape time."""
+        self.queue_depth.set_function(queue_depth)
+        self.cache_bytes.set_function(cache_bytes)
+
+    def reject(self, reason: str) -> None:
+        self.rejected.labels(reason).inc()
+
+    def exposition(self) -> bytes:
+        return generate_latest(self.registry)

@@ -1,0 +1,448 @@
+"""The HTTP API through FastAPI's TestClient, entered as a context manager so the lifespan runs."""
+
+from __future__ import annotations
+
+import io
+import logging
+import threading
+import time
+
+import numpy as np
+import pytest
+from fastapi import FastAPI
+from fastapi.testclient import TestClient
+from PIL import Image
+
+from service.api import WEB_DIR, create_app, mount_web
+from service.presets import all_presets
+from service.renderer import Renderer
+from service.settings import Settings, get_settings
+from service.shaders import ShaderError
+
+pytestmark = pytest.mark.gl
+
+SMALL = "width=64&height=64&quality=draft"
+WAIT = 20.0
+
+
+@pytest.fixture(scope="module")
+def settings(backend) -> Settings:
+    return Settings(gl_backend=backend, warmup=False, workers=1, queue_size=8)
+
+
+@pytest.fixture(scope="module")
+def client(settings):
+    with TestClient(create_app(settings)) as client:
+        yield client
+
+
+def make_client(backend, **overrides) -> TestClient:
+    return TestClient(create_app(Settings(gl_backend=backend, warmup=False, **overrides)))
+
+
+def sample(client: TestClient, name: str, labels: dict[str, str] | None = None) -> float:
+    value = client.app.state.metrics.registry.get_sample_value(name, labels or {})
+    return value or 0.0
+
+
+class Gate:
+    """A pool task that keeps the (only) worker busy until opened."""
+
+    def __init__(self) -> None:
+        self.entered, self.opened = threading.Event(), threading.Event()
+
+    def __call__(self, renderer) -> bytes:
+        self.entered.set()
+        self.opened.wait(WAIT)
+        return b""
+
+
+def occupy(client: TestClient, key: str = "gate") -> Gate:
+    gate = Gate()
+    client.app.state.pool.submit(key, gate)
+    assert gate.entered.wait(WAIT)
+    return gate
+
+
+def problems(response) -> list[str]:
+    detail = response.json()["detail"]
+    return detail if isinstance(detail, list) else [detail]
+
+
+# Operations
+
+
+def test_healthz(client):
+    """/healthz answers 200 while the process is alive."""
+    assert client.get("/healthz").json() == {"status": "ok"}
+
+
+def test_readyz_reports_the_gl_context(client, backend):
+    """/readyz is 200 with the worker's backend and GL renderer string."""
+    body = client.get("/readyz").json()
+    assert body["ready"] is True and body["backend"] == backend
+    assert body["renderer"] and body["workers"][0]["state"] == "ready"
+
+
+def test_readyz_is_503_without_a_context(backend):
+    """/readyz is 503 when no worker could make a GL context, and renders answer 503."""
+    def no_gl():
+        raise RuntimeError("no EGL device")
+
+    app = create_app(Settings(gl_backend=backend, warmup=False), renderer_factory=no_gl)
+    with TestClient(app) as client:
+        assert client.get("/readyz").status_code == 503
+        response = client.get(f"/v1/render?{SMALL}")
+        assert response.status_code == 503 and "Retry-After" in response.headers
+
+
+def test_metrics_exposition(client):
+    """/metrics exposes render latency by preset, cache hits and misses, queue depth, rejections."""
+    client.get(f"/v1/render?preset=nacre&{SMALL}&mu_f=4.25")
+    client.get(f"/v1/render?preset=nacre&{SMALL}&mu_f=4.25")
+    client.get("/v1/render?mu_f=-1")
+    text = client.get("/metrics").text
+    assert 'opaline_render_seconds_count{preset="nacre"}' in text
+    assert "opaline_queue_depth" in text
+    assert sample(client, "opaline_cache_hits_total") >= 1
+    assert sample(client, "opaline_cache_misses_total") >= 1
+    assert sample(client, "opaline_rejected_requests_total", {"reason": "invalid"}) >= 1
+
+
+# Images
+
+
+def test_get_render_png(client):
+    """GET /v1/render gives a PNG of the requested size with a strong ETag and Cache-Control."""
+    response = client.get(f"/v1/render?preset=cd-rom&mu_f=8.5&{SMALL}")
+    assert response.status_code == 200 and response.headers["content-type"] == "image/png"
+    assert Image.open(io.BytesIO(response.content)).size == (64, 64)
+    tag = response.headers["etag"]
+    assert tag.startswith('"') and not tag.startswith("W/")
+    assert response.headers["cache-control"].startswith("public, max-age=")
+
+
+def test_post_render_npy(client):
+    """POST /v1/render with format npy gives linear float32 RGBA as application/x-npy."""
+    body = {"preset": "sphere", "width": 32, "height": 48, "quality": "draft", "format": "npy"}
+    response = client.post("/v1/render", json=body)
+    assert response.headers["content-type"] == "application/x-npy"
+    array = np.load(io.BytesIO(response.content))
+    assert array.shape == (48, 32, 4) and array.dtype == np.float32
+    assert np.isfinite(array).all() and array.max() > 0
+
+
+def test_get_and_post_give_the_same_image(client):
+    """The same parameters by query string or JSON body give the same bytes and ETag."""
+    got = client.get(f"/v1/render?preset=oil-slick&{SMALL}&albedo=0.1,0.2,0.3&theta1=0.5")
+    posted = client.post("/v1/render", json={"preset": "oil-slick", "width": 64, "height": 64,
+                                             "quality": "draft", "albedo": [0.1, 0.2, 0.3],
+                                             "theta1": 0.5})
+    assert got.content == posted.content and got.headers["etag"] == posted.headers["etag"]
+
+
+def test_albedo_query_forms_agree(client):
+    """albedo=R,G,B and albedo repeated three times name the same image."""
+    one = client.get(f"/v1/render?{SMALL}&kd=1&albedo=0.9,0.2,0.1")
+    three = client.get(f"/v1/render?{SMALL}&kd=1&albedo=0.9&albedo=0.2&albedo=0.1")
+    assert one.status_code == three.status_code == 200
+    assert one.headers["etag"] == three.headers["etag"]
+
+
+def test_parameters_change_the_image(client):
+    """A different material gives different bytes and a different ETag."""
+    a = client.get(f"/v1/render?preset=cd-rom&{SMALL}&mu_f=2")
+    b = client.get(f"/v1/render?preset=cd-rom&{SMALL}&mu_f=9")
+    assert a.content != b.content and a.headers["etag"] != b.headers["etag"]
+
+
+def test_repeated_get_with_etag_is_304(client):
+    """A GET whose If-None-Match holds the ETag answers 304 with no body; another tag gets 200."""
+    url = f"/v1/render?preset=sphere&{SMALL}&mu_f=3.5"
+    first = client.get(url)
+    tag = first.headers["etag"]
+    again = client.get(url, headers={"If-None-Match": tag})
+    assert again.status_code == 304 and again.content == b""
+    assert again.headers["etag"] == tag and "max-age" in again.headers["cache-control"]
+    assert client.get(url, headers={"If-None-Match": f'"other", W/{tag}'}).status_code == 304
+    assert client.get(url, headers={"If-None-Match": '"other"'}).status_code == 200
+
+
+def test_mdf_plot_png_and_npy(client):
+    """GET /v1/mdf gives the N×N plot: PNG to view, npy of linear D (0 outside the disc)."""
+    png = client.get("/v1/mdf?mdf=ashikhmin&ex=100&ey=10&size=64")
+    assert png.headers["content-type"] == "image/png"
+    assert Image.open(io.BytesIO(png.content)).size == (64, 64)
+    raw = client.get("/v1/mdf?mu_f=5&alpha=1&beta=0.1&size=32&format=npy")
+    plot = np.load(io.BytesIO(raw.content))
+    assert plot.shape == (32, 32, 3) and plot[0, 0].max() == 0 and plot.max() > 0
+    assert "etag" in raw.headers
+
+
+def test_presets_list(client):
+    """GET /v1/presets lists every preset with description, figure, geometry and defaults."""
+    listed = {p["name"]: p for p in client.get("/v1/presets").json()}
+    assert set(listed) == set(all_presets())
+    cd = listed["cd-rom"]
+    assert cd["description"] and cd["figure"] and cd["geometry"]["kind"]
+    assert cd["defaults"]["mu_f"] == 8.5 and cd["resolved"]["material"]["mu_f"] == 8.5
+
+
+def test_preset_detail(client):
+    """GET /v1/presets/{name} gives that preset's resolved defaults."""
+    body = client.get("/v1/presets/oil-slick").json()
+    assert body["name"] == "oil-slick" and body["resolved"]["width"] == 256
+
+
+def test_root_serves_the_web_page_or_the_docs(client):
+    """/ serves service/web/index.html when the package has it, else redirects to /docs."""
+    response = client.get("/", follow_redirects=False)
+    if (WEB_DIR / "index.html").is_file():
+        assert response.status_code == 200 and "text/html" in response.headers["content-type"]
+    else:
+        assert response.status_code in (302, 307) and response.headers["location"] == "/docs"
+
+
+def test_root_redirects_to_docs_without_web_page(tmp_path):
+    """Without index.html in the web folder, / redirects to /docs and /static does not exist."""
+    app = FastAPI()
+    mount_web(app, tmp_path)
+    with TestClient(app) as client:
+        response = client.get("/", follow_redirects=False)
+        assert response.status_code in (302, 307) and response.headers["location"] == "/docs"
+        assert client.get("/static/app.js").status_code == 404
+
+
+def test_web_page_served_when_present(tmp_path):
+    """With a web folder holding index.html, / serves it and /static serves its files."""
+    (tmp_path / "index.html").write_text("<h1>Opaline</h1>")
+    (tmp_path / "app.js").write_text("console.log(1)")
+    app = FastAPI()
+    mount_web(app, tmp_path)
+    with TestClient(app) as client:
+        assert client.get("/").text == "<h1>Opaline</h1>"
+        assert client.get("/static/app.js").text == "console.log(1)"
+
+
+# Bad input
+
+
+@pytest.mark.parametrize(("query", "field", "allowed"), [
+    ("mu_f=2000", "mu_f=", "[0 … 1000]"),
+    ("theta1=7", "theta1=", "2π"),
+    ("width=8", "width=", "[16 … 2048]"),
+    ("samples=0", "samples=", "[1 … 1024]"),
+    ("albedo=0.1,2,0.3", "albedo", "[0 … 1]"),
+    ("wavelengths=2", "wavelengths=", "3 … 128"),
+    ("exposure=0", "exposure=", "(0 … 1000]"),
+])
+def test_out_of_range_query_is_422_naming_field_and_range(client, query, field, allowed):
+    """An out-of-range parameter answers 422, naming the field, the value and the range."""
+    response = client.get(f"/v1/render?{query}")
+    assert response.status_code == 422
+    lines = problems(response)
+    assert any(field in line and allowed in line for line in lines), lines
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_non_finite_query_is_422(client, value):
+    """Non-finite numbers in the query string are refused, naming the field."""
+    response = client.get(f"/v1/render?mu_f={value}")
+    assert response.status_code == 422
+    assert any("mu_f" in line and "finite" in line for line in problems(response))
+
+
+@pytest.mark.parametrize("body", [b'{"ks": NaN}', b'{"ks": Infinity}', b'{"ks": 1e999}'])
+def test_non_finite_body_is_422(client, body):
+    """Non-finite numbers in a JSON body are refused, naming the field and its range."""
+    response = client.post("/v1/render", content=body,
+                           headers={"content-type": "application/json"})
+    assert response.status_code == 422
+    assert any(line.startswith("ks=") and "[0 … 100]" in line for line in problems(response))
+
+
+def test_unknown_query_field_is_422(client):
+    """An unknown query parameter is refused, and the message lists the known ones."""
+    lines = problems(client.get("/v1/render?muf=3"))
+    assert any("muf" in line and "unknown" in line and "mu_f" in line for line in lines)
+
+
+def test_unknown_body_field_is_422(client):
+    """An unknown JSON field is refused, naming it."""
+    response = client.post("/v1/render", json={"preset": "sphere", "colour": "red"})
+    assert response.status_code == 422
+    assert any(line.startswith("colour") for line in problems(response))
+
+
+def test_bad_choice_and_bad_json_are_422(client):
+    """A value outside a choice, invalid JSON and a missing body each answer 422 with one line."""
+    assert "format" in problems(client.get("/v1/render?format=jpg"))[0]
+    bad = client.post("/v1/render", content=b"{", headers={"content-type": "application/json"})
+    assert bad.status_code == 422 and "JSON" in problems(bad)[0]
+    empty = client.post("/v1/render", content=b"", headers={"content-type": "application/json"})
+    assert empty.status_code == 422
+
+
+def test_mdf_bad_input_is_422(client):
+    """The MDF route checks its own fields: size, format and wavelengths."""
+    lines = problems(client.get("/v1/mdf?size=4096&format=png16&wavelengths=200&bogus=1"))
+    for name in ("size=", "format=", "wavelengths=", "bogus"):
+        assert any(line.startswith(name) for line in lines), lines
+    assert any(line.startswith("size=") and "[16 … 2048]" in line for line in lines)
+    assert any(line.startswith("bogus") and "size" in line for line in lines)
+
+
+def test_unknown_preset_is_404_listing_presets(client):
+    """An unknown preset answers 404 whose message lists the valid names."""
+    for response in (client.get("/v1/render?preset=teapot"), client.get("/v1/presets/teapot"),
+                     client.post("/v1/render", json={"preset": "teapot"})):
+        assert response.status_code == 404
+        assert "teapot" in response.json()["detail"] and "cd-rom" in response.json()["detail"]
+
+
+def test_cost_over_budget_is_422_naming_the_budget(backend):
+    """A request over the cost budget answers 422 whose message names the budget."""
+    budget = 64 * 64 * 1 * 3  # one draft 64² image
+    with make_client(backend, cost_budget=budget) as client:
+        assert client.get(f"/v1/render?{SMALL}").status_code == 200
+        response = client.get("/v1/render?width=128&height=64&quality=draft")
+        assert response.status_code == 422
+        assert f"budget of {budget}" in problems(response)[0]
+        assert client.get("/v1/mdf?size=128").status_code == 422
+
+
+def test_size_over_service_limit_is_422(backend):
+    """A size within the parameter range but over the service's max_width answers 422."""
+    with make_client(backend, max_width=128, max_height=96) as client:
+        lines = problems(client.get("/v1/render?width=256&height=256"))
+        assert any(line.startswith("width=256") and "128" in line for line in lines)
+        assert any(line.startswith("height=256") and "96" in line for line in lines)
+        assert client.get("/v1/mdf?size=200").status_code == 422
+
+
+def test_body_over_limit_is_413(backend):
+    """A body over max_body_bytes answers 413, by Content-Length or counted while streaming."""
+    with make_client(backend, max_body_bytes=1024) as client:
+        padded = b'{"preset": "sphere"' + b" " * 2000 + b"}"
+        response = client.post("/v1/render", content=padded,
+                               headers={"content-type": "application/json"})
+        assert response.status_code == 413
+
+        def chunks():
+            yield padded[:600]
+            yield padded[600:]
+
+        streamed = client.post("/v1/render", content=chunks(),
+                               headers={"content-type": "application/json"})
+        assert streamed.status_code == 413
+        assert sample(client, "opaline_rejected_requests_total", {"reason": "too_large"}) == 2
+
+
+def test_settings_come_from_env_and_dependency_overrides(backend, monkeypatch):
+    """OPALINE_* variables set the settings; overriding get_settings changes what routes use."""
+    monkeypatch.setenv("OPALINE_MAX_WIDTH", "100")
+    monkeypatch.setenv("OPALINE_GL_BACKEND", backend.upper())
+    assert Settings().max_width == 100 and Settings().gl_backend == backend
+    monkeypatch.delenv("OPALINE_MAX_WIDTH")
+    with make_client(backend) as client:
+        assert client.get(f"/v1/render?{SMALL}&width=128").status_code == 200
+        client.app.dependency_overrides[get_settings] = lambda: Settings(max_width=100)
+        assert client.get(f"/v1/render?{SMALL}&width=128").status_code == 422
+
+
+# Load and failure
+
+
+def test_full_queue_is_503_with_retry_after(backend):
+    """With the worker busy and the queue full, a new render answers 503 with Retry-After."""
+    with make_client(backend, queue_size=1) as client:
+        gate = occupy(client)
+        client.app.state.pool.submit("queued", lambda renderer: b"")
+        response = client.get(f"/v1/render?{SMALL}&mu_f=1.25")
+        gate.opened.set()
+        assert response.status_code == 503 and response.headers["retry-after"] == "1"
+        assert sample(client, "opaline_rejected_requests_total", {"reason": "queue_full"}) == 1
+        assert client.get(f"/v1/render?{SMALL}&mu_f=1.25").status_code == 200
+
+
+def test_request_past_deadline_is_503(backend):
+    """A request that waited in the queue past deadline_s is dropped and answers 503."""
+    with make_client(backend, deadline_s=0.1) as client:
+        gate = occupy(client)
+        answers: list = []
+        asker = threading.Thread(
+            target=lambda: answers.append(client.get(f"/v1/render?{SMALL}&mu_f=1.75")))
+        asker.start()
+        time.sleep(0.3)
+        gate.opened.set()
+        asker.join(WAIT)
+        assert answers[0].status_code == 503 and "Retry-After" in answers[0].headers
+        assert sample(client, "opaline_rejected_requests_total", {"reason": "deadline"}) == 1
+        assert sample(client, "opaline_render_seconds_count", {"preset": "sphere"}) == 0
+
+
+def test_identical_concurrent_requests_render_once(backend):
+    """N identical concurrent requests get the same image from a single render."""
+    count = 6
+    with make_client(backend) as client:
+        gate = occupy(client)
+        url = f"/v1/render?preset=perturbed-cube&{SMALL}"
+        answers: list = []
+        askers = [threading.Thread(target=lambda: answers.append(client.get(url)))
+                  for _ in range(count)]
+        for asker in askers:
+            asker.start()
+        end = time.monotonic() + WAIT
+        while sample(client, "opaline_cache_misses_total") < count and time.monotonic() < end:
+            time.sleep(0.01)
+        gate.opened.set()
+        for asker in askers:
+            asker.join(WAIT)
+        assert [a.status_code for a in answers] == [200] * count
+        assert len({a.content for a in answers}) == 1
+        renders = sample(client, "opaline_render_seconds_count", {"preset": "perturbed-cube"})
+        assert renders == 1
+
+
+class BrokenRenderer(Renderer):
+    def render(self, job, preset=None):
+        raise ShaderError("surface.glsl:12: error: SECRET-COMPILE-LOG")
+
+
+def test_render_failure_is_500_without_the_log(backend, caplog):
+    """A shader failure answers 500 with an incident id; the compile log stays in the server log."""
+    app = create_app(Settings(gl_backend=backend, warmup=False),
+                     renderer_factory=lambda: BrokenRenderer(backend))
+    with caplog.at_level(logging.ERROR), TestClient(app) as client:
+        response = client.get(f"/v1/render?{SMALL}")
+        assert response.status_code == 500
+        assert "incident" in response.json()["detail"]
+        assert "SECRET" not in response.text
+        assert client.get("/healthz").status_code == 200
+    assert "SECRET-COMPILE-LOG" in caplog.text
+
+
+def test_shutdown_releases_the_workers(backend):
+    """Leaving the lifespan stops every worker (each releases its context on its own thread)."""
+    client = make_client(backend, workers=2)
+    with client:
+        assert client.get("/readyz").status_code == 200
+    assert [w["state"] for w in client.app.state.pool.status()] == ["stopped", "stopped"]
+
+
+# OpenAPI
+
+
+def test_openapi_documents_every_parameter_and_media_type(client):
+    """/docs' schema gives each image parameter a description, numeric ones their bounds."""
+    spec = client.get("/openapi.json").json()
+    params = spec["paths"]["/v1/render"]["get"]["parameters"]
+    for param in params:
+        assert param["description"], param["name"]
+    bounded = {p["name"]: p["schema"]["anyOf"][0] for p in params if p["name"] in ("mu_f", "width")}
+    assert bounded["mu_f"]["maximum"] == 1000 and bounded["width"]["minimum"] == 16
+    for path, method in (("/v1/render", "get"), ("/v1/render", "post"), ("/v1/mdf", "get")):
+        content = spec["paths"][path][method]["responses"]["200"]["content"]
+        assert {"image/png", "application/x-npy"} <= set(content)
+    assert "Retry-After" in spec["paths"]["/v1/render"]["get"]["responses"]["503"]["headers"]
+    assert client.get("/docs").status_code == 200

@@ -1,0 +1,209 @@
+"""Material files and manifests parse into the request model, with errors that name the file."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from service import materials
+from service.cli import main
+from service.materials import MaterialError, collect, load_material, material_schema
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_toml_material_parses_into_the_request_model(tmp_path):
+    """Every field of a TOML material file arrives in the RenderRequest, tuples included."""
+    path = write(tmp_path / "disc.toml", 'preset = "cd-rom"\nmu_f = 6\nwidth = 64\n'
+                 'albedo = [0.1, 0.2, 0.3]\nquality = "draft"\n')
+    request = load_material(path)
+    assert request.preset == "cd-rom" and request.mu_f == 6.0 and request.width == 64
+    assert request.albedo == (0.1, 0.2, 0.3) and request.quality == "draft"
+    assert request.height is None, "unset fields stay unset (the preset decides)"
+
+
+def test_json_material_may_name_its_schema(tmp_path):
+    """A JSON material file parses the same, and its "$schema" key is ignored."""
+    path = write(tmp_path / "ball.json", json.dumps(
+        {"$schema": "../docs/material.schema.json", "preset": "sphere", "alpha": 3}))
+    request = load_material(path)
+    assert request.preset == "sphere" and request.alpha == 3.0
+
+
+def test_out_of_range_value_names_file_field_value_and_range(tmp_path):
+    """An out-of-range field is rejected, never clamped, and the message says where and why."""
+    path = write(tmp_path / "hot.toml", 'preset = "cd-rom"\nmu_f = 5000\ntheta1 = 7\n')
+    with pytest.raises(MaterialError) as info:
+        load_material(path)
+    message = str(info.value)
+    assert message.startswith(str(path))
+    assert "mu_f=5000" in message and "[0 … 1000]" in message
+    assert "theta1=7" in message and "2π" in message
+
+
+def test_unknown_field_is_rejected_with_the_known_ones(tmp_path):
+    """A misspelt field is an error that lists the real field names."""
+    path = write(tmp_path / "typo.toml", "muf = 3\n")
+    with pytest.raises(MaterialError, match=r"muf: unknown field \(known fields: .*mu_f"):
+        load_material(path)
+
+
+@pytest.mark.parametrize("name, text, kind", [("x.toml", "mu_f = = 3", "TOML"),
+                                              ("x.json", "{mu_f: 3", "JSON")])
+def test_syntax_error_names_the_file_and_format(tmp_path, name, text, kind):
+    """A file that is not valid TOML/JSON fails with its name and the parser's message."""
+    path = write(tmp_path / name, text)
+    with pytest.raises(MaterialError, match=rf"{re.escape(str(path))}: invalid {kind}"):
+        load_material(path)
+
+
+def test_non_table_json_is_rejected(tmp_path):
+    """A JSON list is not a material."""
+    path = write(tmp_path / "list.json", "[1, 2]")
+    with pytest.raises(MaterialError, match="expected a table"):
+        load_material(path)
+
+
+def test_folder_is_collected_recursively_sorted_with_relative_names(tmp_path):
+    """Folder inputs give every *.toml/*.json below them, sorted, named by relative path."""
+    write(tmp_path / "m/b.toml", "mu_f = 2\n")
+    write(tmp_path / "m/a.json", '{"mu_f": 1}')
+    write(tmp_path / "m/sub/c.toml", "mu_f = 3\n")
+    write(tmp_path / "m/.hidden.toml", "mu_f = 4\n")
+    write(tmp_path / "m/notes.txt", "not a material")
+    write(tmp_path / "m/out/old.png.json", '{"key": "x"}')
+    items = collect([tmp_path / "m"], exclude=[tmp_path / "m/out"])
+    assert [i.name for i in items] == ["a", "b", "sub/c"]
+    assert [i.request.mu_f for i in items] == [1.0, 2.0, 3.0]
+
+
+def test_duplicate_output_names_fail_the_second(tmp_path):
+    """Two inputs that would write the same image: the second fails and says who has the name."""
+    write(tmp_path / "m/disc.toml", "mu_f = 2\n")
+    write(tmp_path / "m/disc.json", '{"mu_f": 3}')
+    first, second = collect([tmp_path / "m"])
+    assert first.error is None and first.source.endswith("disc.json")
+    assert second.request is None and "already used by" in second.error
+
+
+def test_missing_input_is_an_item_error_not_an_exception(tmp_path):
+    """A path that does not exist becomes a failed item, so the others still render."""
+    write(tmp_path / "ok.toml", "mu_f = 2\n")
+    missing, ok = collect([tmp_path / "nope.toml", tmp_path / "ok.toml"])
+    assert "no such file" in missing.error and ok.error is None
+
+
+def test_manifest_merges_defaults_file_entry_and_overrides_in_that_order(tmp_path):
+    """Manifest defaults < the referenced file < the entry's fields < command-line overrides."""
+    write(tmp_path / "disc.toml", 'preset = "cd-rom"\nmu_f = 6\nwidth = 100\nheight = 100\n')
+    manifest = write(tmp_path / "set.manifest.toml", """
+[defaults]
+width = 64
+height = 64
+quality = "draft"
+alpha = 9
+
+[[material]]
+name = "inline"
+preset = "oil-slick"
+mu_f = 4
+
+[[material]]
+path = "disc.toml"
+name = "disc-wide"
+width = 96
+
+[[material]]
+path = "disc.toml"
+""")
+    items = collect([manifest], overrides={"quality": "standard"})
+    assert [i.name for i in items] == ["inline", "disc-wide", "disc"]
+    inline, wide, disc = (i.request for i in items)
+    assert (inline.preset, inline.mu_f, inline.width, inline.alpha) == ("oil-slick", 4.0, 64, 9.0)
+    assert (wide.preset, wide.mu_f, wide.width, wide.height) == ("cd-rom", 6.0, 96, 100)
+    assert disc.width == 100 and all(r.quality == "standard" for r in (inline, wide, disc))
+
+
+def test_manifest_entries_fail_one_by_one(tmp_path):
+    """A bad entry fails alone, with the manifest, the entry name and the reason."""
+    manifest = write(tmp_path / "set.manifest.json", json.dumps({"material": [
+        {"name": "good", "mu_f": 1},
+        {"name": "hot", "mu_f": -1},
+        {"name": "../escape", "mu_f": 1},
+        {"mu_f": 1},
+        {"name": "lost", "path": "missing.toml"},
+    ]}))
+    good, hot, escape, unnamed, lost = collect([manifest])
+    assert good.error is None
+    assert f"{manifest}[hot]: mu_f=-1 is out of range" in hot.error
+    assert "must be letters" in escape.error and escape.request is None
+    assert "name=None" in unnamed.error
+    assert "cannot read" in lost.error
+
+
+def test_manifest_with_unknown_top_level_key_fails_as_a_whole(tmp_path):
+    """A manifest's own structure is checked: unknown keys and an empty list are errors."""
+    bad = write(tmp_path / "a.manifest.toml", '[[materials]]\nname = "x"\n')
+    empty = write(tmp_path / "b.manifest.toml", "[defaults]\nwidth = 64\n")
+    (item_a,), (item_b,) = collect([bad]), collect([empty])
+    assert "unknown key(s) materials" in item_a.error
+    assert "non-empty list" in item_b.error
+
+
+def test_manifest_in_a_folder_prefixes_its_subfolder(tmp_path):
+    """A manifest found inside a folder input names its entries relative to that folder."""
+    write(tmp_path / "m/set/x.manifest.toml", '[[material]]\nname = "e"\nmu_f = 1\n')
+    (item,) = collect([tmp_path / "m"])
+    assert item.name == "set/e" and item.error is None
+
+
+def test_schema_command_prints_the_file_format_and_docs_copy_is_current(capsys):
+    """`opaline schema` prints the request schema, titled; docs/material.schema.json is a copy."""
+    assert main(["schema"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed == material_schema()
+    assert printed["title"] == "Opaline material file" and printed["additionalProperties"] is False
+    assert printed["properties"]["mu_f"]["anyOf"][0]["maximum"] == 1000
+    assert "$schema" in printed["properties"]
+    docs = json.loads((ROOT / "docs/material.schema.json").read_text())
+    assert docs == printed, "regenerate with: opaline schema -o docs/material.schema.json"
+
+
+def test_schema_command_writes_a_file(tmp_path):
+    """`opaline schema -o FILE` writes the same JSON to FILE."""
+    target = tmp_path / "s.json"
+    assert main(["schema", "-o", str(target)]) == 0
+    assert json.loads(target.read_text()) == material_schema()
+
+
+def doc_examples() -> list[tuple[str, str]]:
+    """Code blocks in docs/materials.md that start with a `# file: NAME` (or JSON "//") line."""
+    text = (ROOT / "docs/materials.md").read_text()
+    blocks = re.findall(r"```(?:toml|json)\n(.*?)```", text, flags=re.S)
+    found = []
+    for block in blocks:
+        first, _, body = block.partition("\n")
+        match = re.match(r"(?:#|//) file: (\S+)", first)
+        if match:
+            found.append((match.group(1), body))
+    return found
+
+
+def test_every_example_in_the_docs_is_valid(tmp_path):
+    """The material files and manifests shown in docs/materials.md all parse without error."""
+    examples = doc_examples()
+    assert len(examples) >= 4
+    for name, body in examples:
+        write(tmp_path / "docs" / name, body)
+    items = collect([tmp_path / "docs"])
+    assert items and all(i.error is None for i in items), [i.error for i in items if i.error]
+    assert any(materials.is_manifest(Path(name)) for name, _ in examples)

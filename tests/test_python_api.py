@@ -1,0 +1,142 @@
+"""`from service import render`: a request in, the same bytes as every other path out."""
+
+from __future__ import annotations
+
+import io
+import subprocess
+import sys
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from service import api_python
+from service.params import RenderRequest
+from service.presets import UnknownPreset
+
+pytestmark = pytest.mark.gl
+ROOT = Path(__file__).resolve().parent.parent
+DISC = {"preset": "cd-rom", "mu_f": 6, "width": 64, "height": 48, "quality": "draft"}
+
+
+@pytest.fixture(scope="module")
+def on_thread(backend):
+    """Runs calls on one dedicated thread, so its context never meets the session's."""
+    pool = ThreadPoolExecutor(1)
+
+    def call(fn, *args, **kwargs):
+        kwargs.setdefault("backend", backend)
+        return pool.submit(fn, *args, **kwargs).result()
+
+    yield call
+    pool.submit(api_python.close).result()
+    pool.shutdown()
+
+
+def test_importing_service_stays_light():
+    """`import service` loads no GL, NumPy or pydantic; `service.render` loads them on use."""
+    code = ("import sys, service; heavy = {'moderngl', 'numpy', 'pydantic'} & set(sys.modules); "
+            "assert not heavy, heavy; from service import render, render_array; "
+            "assert render is service.api_python.render and 'moderngl' in sys.modules; "
+            "assert render_array is service.api_python.render_array")
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+
+
+def test_unknown_attribute_of_service_is_an_attribute_error():
+    """The lazy `service.__getattr__` still raises AttributeError for names it does not know."""
+    import service
+
+    with pytest.raises(AttributeError):
+        service.no_such_thing  # noqa: B018
+
+
+def test_render_dict_gives_a_png_of_the_requested_size(on_thread):
+    """render(dict) returns PNG bytes of the request's size with a visible object."""
+    data = on_thread(api_python.render, DISC)
+    with Image.open(io.BytesIO(data)) as image:
+        assert image.format == "PNG" and image.size == (64, 48)
+        assert np.asarray(image.convert("RGB")).std() > 5
+
+
+def test_render_matches_local_renderer_bytes(on_thread, backend):
+    """The Python API, a RenderRequest and a dict all give the LocalRenderer's exact bytes."""
+    from service.pipeline import LocalRenderer
+
+    def local_bytes(backend):
+        with LocalRenderer(backend) as renderer:
+            return renderer.render_bytes(RenderRequest(**DISC))
+
+    expected = ThreadPoolExecutor(1).submit(local_bytes, backend).result()
+    assert on_thread(api_python.render, DISC) == expected
+    assert on_thread(api_python.render, RenderRequest(**DISC)) == expected
+
+
+def test_render_array_is_linear_float_rgba(on_thread):
+    """render_array gives (H, W, 4) float32, finite, non-negative, whatever the format asked."""
+    array = on_thread(api_python.render_array, {**DISC, "format": "png"})
+    assert array.shape == (48, 64, 4) and array.dtype == np.float32
+    assert np.isfinite(array).all() and (array >= 0).all() and array[..., 3].max() > 0.5
+
+
+def test_render_of_a_material_file_path(on_thread, tmp_path):
+    """A pathlib.Path is read as a material file."""
+    path = tmp_path / "disc.toml"
+    path.write_text('preset = "cd-rom"\nmu_f = 6\nwidth = 64\nheight = 48\nquality = "draft"\n')
+    assert on_thread(api_python.render, path) == on_thread(api_python.render, DISC)
+
+
+def test_invalid_request_raises_with_field_value_and_range(on_thread):
+    """An out-of-range value raises RequestError naming it; nothing is clamped."""
+    with pytest.raises(api_python.RequestError) as info:
+        on_thread(api_python.render, {**DISC, "mu_f": 5000, "width": 4})
+    assert any("mu_f=5000 is out of range: allowed [0 … 1000]" in p for p in info.value.problems)
+    assert any(p.startswith("width=4") for p in info.value.problems)
+    assert isinstance(info.value, ValueError)
+
+
+def test_unknown_preset_and_wrong_type_raise(on_thread):
+    """An unknown preset raises UnknownPreset; a non-request argument raises TypeError."""
+    with pytest.raises(UnknownPreset):
+        on_thread(api_python.render, {"preset": "nope"})
+    with pytest.raises(TypeError):
+        on_thread(api_python.render, "cd-rom")
+
+
+def test_one_renderer_per_thread_each_correct(on_thread, backend):
+    """Each thread gets its own renderer, reused for its calls, and the same bytes."""
+    first = on_thread(api_python.render, DISC)
+    seen = {}
+
+    def worker(index):
+        api_python.render(DISC, backend=backend)
+        seen[index] = (api_python.renderer(backend), api_python.render(DISC, backend=backend))
+        api_python.close()
+
+    threads = [threading.Thread(target=worker, args=(i,)) for i in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=60)
+    assert seen[0][0] is not seen[1][0]
+    assert seen[0][1] == seen[1][1] == first
+
+
+def test_another_context_on_the_thread_does_not_corrupt_renders(on_thread, backend):
+    """A second GL context made on the same thread (which becomes current) changes nothing."""
+    from service.context import create_context
+
+    def with_intruder(backend):
+        before = api_python.render(DISC, backend=backend)
+        intruder = create_context(backend)
+        try:
+            return before, api_python.render(DISC, backend=backend)
+        finally:
+            intruder.release()
+
+    before, after = on_thread(with_intruder)
+    assert before == after

@@ -1,0 +1,274 @@
+"""The web page works end to end in a real headless Chromium against a real service."""
+
+from __future__ import annotations
+
+import base64
+import os
+import shlex
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CHROMIUM = Path("/usr/bin/chromium")
+# Only 127.0.0.1 traffic: no background networking, updates, sync or QUIC probes.
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update",
+                 "--disable-sync"]
+WAIT_MS = 15_000  # the longest any one step may take in the browser
+START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up render
+PROXY_VARS = {"http_proxy", "https_proxy", "all_proxy", "HTTP_PROXY", "HTTPS_PROXY", "ALL_PROXY"}
+
+pytestmark = pytest.mark.skipif(not CHROMIUM.exists(),
+                                reason=f"{CHROMIUM} is missing (Debian's chromium package)")
+
+
+def local_env(**extra: str) -> dict[str, str]:
+    """The environment without proxies: every request here goes to 127.0.0.1."""
+    env = {k: v for k, v in os.environ.items() if k not in PROXY_VARS}
+    return {**env, "NO_PROXY": "127.0.0.1,localhost", "no_proxy": "127.0.0.1,localhost", **extra}
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def wait_healthy(base: str, proc: subprocess.Popen, log: Path) -> None:
+    opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
+    deadline = time.monotonic() + START_S
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            pytest.fail(f"the service exited with {proc.returncode}:\n{log.read_text()[-3000:]}")
+        try:
+            with opener.open(f"{base}/healthz", timeout=2) as resp:
+                if resp.status == 200:
+                    return
+        except (urllib.error.URLError, OSError):
+            pass
+        time.sleep(0.2)
+    pytest.fail(f"the service did not answer /healthz in {START_S:.0f} s:\n"
+                f"{log.read_text()[-3000:]}")
+
+
+@pytest.fixture(scope="module")
+def server():
+    """``opaline serve`` as a real uvicorn process on a free port of 127.0.0.1."""
+    port = free_port()
+    with tempfile.TemporaryDirectory() as tmp:
+        log = Path(tmp) / "serve.log"
+        with log.open("wb") as out:
+            proc = subprocess.Popen(
+                [sys.executable, "-m", "service.cli", "serve", "--host", "127.0.0.1",
+                 "--port", str(port), "--workers", "1", "--log-level", "warning"],
+                cwd=ROOT, env=local_env(PYTHONPATH=str(ROOT)), stdout=out,
+                stderr=subprocess.STDOUT)
+        base = f"http://127.0.0.1:{port}"
+        try:
+            wait_healthy(base, proc, log)
+            yield base
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(timeout=5)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        chromium = pw.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS,
+                                      timeout=WAIT_MS)
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture
+def page(browser, server):
+    """A fresh page; fails the test on any uncaught script error."""
+    context = browser.new_context(viewport={"width": 1280, "height": 800})
+    context.set_default_timeout(WAIT_MS)
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    page.base = server  # type: ignore[attr-defined]
+    yield page
+    context.close()
+    assert not errors, f"script errors in the page: {errors}"
+
+
+def open_page(page, query: str = ""):
+    page.goto(f"{page.base}/{query}")
+    settle(page)
+
+
+def settle(page) -> None:
+    """Wait until the page has no change pending and every answer is shown."""
+    page.wait_for_function("document.body.dataset.busy === 'false'", timeout=WAIT_MS)
+
+
+def shown_bytes(page, selector: str = "#preview") -> bytes:
+    """The bytes of the image the page shows (its object URL, read back)."""
+    data = page.evaluate(
+        """async (selector) => {
+             const img = document.querySelector(selector);
+             if (!img.src.startsWith('blob:')) return null;
+             const bytes = new Uint8Array(await (await fetch(img.src)).arrayBuffer());
+             let text = '';
+             for (let i = 0; i < bytes.length; i += 8192) {
+               text += String.fromCharCode(...bytes.subarray(i, i + 8192));
+             }
+             return btoa(text);
+           }""", selector)
+    assert data, f"{selector} shows no fetched image"
+    return base64.b64decode(data)
+
+
+def test_page_loads_with_controls_from_the_schema(page):
+    """The page loads, shows a PNG preview and MDF plot, and takes its ranges from the API."""
+    open_page(page)
+    assert page.title().startswith("Opaline")
+    assert shown_bytes(page).startswith(b"\x89PNG")
+    assert shown_bytes(page, "#mdf").startswith(b"\x89PNG")
+    assert page.input_value("#preset") == "sphere"
+    assert page.get_attribute("#in-mu_f", "max") == "1000"
+    assert page.get_attribute("#in-theta1", "min").startswith("-6.28")
+    assert "Multi-peak frequency" in page.text_content("#desc-mu_f")
+    for name in ("mdf", "ex", "ey", "mu_f", "alpha", "beta", "theta1", "theta2", "kd", "ks",
+                 "f0", "light_azimuth", "light_elevation", "width", "height", "quality",
+                 "format"):
+        assert page.locator(f"#in-{name}").count() == 1, name
+    assert page.locator("#rng-ex").count() == 1 and page.locator("#in-albedo-0").count() == 1
+
+
+def test_preset_and_slider_change_the_preview(page):
+    """Choosing a preset, then moving a slider, each change the preview's bytes."""
+    open_page(page)
+    sphere = shown_bytes(page)
+    page.select_option("#preset", "cd-rom")
+    settle(page)
+    cd_rom = shown_bytes(page)
+    assert cd_rom != sphere
+    assert page.input_value("#in-mu_f") == "8.5"
+    page.focus("#rng-mu_f")
+    for _ in range(3):
+        page.keyboard.press("ArrowRight")
+    settle(page)
+    assert page.input_value("#in-mu_f") != "8.5"
+    assert shown_bytes(page) != cd_rom
+    assert "mu_f=" in page.get_attribute("#preview", "data-url")
+
+
+def test_out_of_range_value_shows_the_api_message_by_its_control(page):
+    """mu_f=2000 shows the API's 422 line beside mu_f and keeps the last good image."""
+    open_page(page, "?preset=cd-rom")
+    good = shown_bytes(page)
+    page.fill("#in-mu_f", "2000")
+    settle(page)
+    message = page.locator('.field[data-field="mu_f"] .error')
+    assert message.is_visible()
+    text = message.text_content()
+    assert text.startswith("mu_f=") and "out of range" in text and "1000" in text, text
+    assert page.get_attribute("#in-mu_f", "aria-invalid") == "true"
+    assert page.locator("#err-general").is_hidden()
+    assert shown_bytes(page) == good
+    page.fill("#in-mu_f", "9")
+    settle(page)
+    assert message.is_hidden()
+    assert shown_bytes(page) != good
+
+
+def test_copied_curl_returns_the_shown_bytes(page, tmp_path):
+    """Dragging the preview moves the light; "Copy as curl", run, gets the bytes shown."""
+    open_page(page, "?preset=cd-rom")
+    page.fill("#in-theta2", "0.5")
+    box = page.locator("#stage").bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] * 0.7, box["y"] + box["height"] * 0.4, steps=4)
+    page.mouse.up()
+    settle(page)
+    azimuth = page.input_value("#in-light_azimuth")
+    assert azimuth not in ("", "0") and page.input_value("#in-light_elevation") != ""
+    page.focus("#stage")
+    page.keyboard.press("ArrowLeft")
+    settle(page)
+    assert float(page.input_value("#in-light_azimuth")) == pytest.approx(float(azimuth) - 5)
+    shown = shown_bytes(page)
+
+    page.check('input[name="copy-kind"][value="curl"]')
+    assert page.locator("#copy-curl").is_visible()
+    command = shlex.split(page.input_value("#copy-curl"))
+    assert command[0] == "curl" and "-o" in command
+    out = tmp_path / command[command.index("-o") + 1]
+    run = subprocess.run(command, cwd=tmp_path, env=local_env(), capture_output=True,
+                         timeout=30, check=False)
+    assert run.returncode == 0, run.stderr.decode()
+    assert out.read_bytes() == shown
+
+
+def test_shareable_url_restores_the_state(page, browser):
+    """The page's link, opened afresh, restores every control and the same image."""
+    open_page(page)
+    page.select_option("#preset", "oil-slick")
+    settle(page)
+    page.fill("#in-mu_f", "12")
+    page.select_option("#in-quality", "draft")
+    page.fill("#in-albedo-0", "0.2")
+    page.fill("#in-width", "320")
+    settle(page)
+    link = page.input_value("#copy-url")
+    assert link.startswith(page.base) and "preset=oil-slick" in link
+    body = page.input_value("#copy-json")
+    shown = shown_bytes(page)
+
+    other = browser.new_page(viewport={"width": 800, "height": 700})
+    try:
+        other.goto(link)
+        settle(other)
+        assert other.input_value("#preset") == "oil-slick"
+        assert other.input_value("#in-mu_f") == "12"
+        assert other.input_value("#in-quality") == "draft"
+        assert other.input_value("#in-albedo-0") == "0.2"
+        assert other.input_value("#in-width") == "320"
+        assert other.input_value("#copy-json") == body
+        assert shown_bytes(other) == shown
+    finally:
+        other.close()
+
+
+def test_busy_service_is_shown_and_retried(page):
+    """A 503 with Retry-After shows its message, keeps the image, and is retried after it."""
+    open_page(page, "?preset=cd-rom")
+    good = shown_bytes(page)
+    refused: list[str] = []
+
+    def busy_once(route):
+        if refused:
+            route.continue_()
+            return
+        refused.append(route.request.url)
+        route.fulfill(status=503, headers={"Retry-After": "1"}, content_type="application/json",
+                      body='{"detail": "the render queue is full; retry later"}')
+
+    page.route("**/v1/render?*", busy_once)
+    page.fill("#in-mu_f", "7")
+    page.wait_for_function(
+        "document.querySelector('#err-general').textContent.includes('queue is full')")
+    assert "busy" in page.text_content("#status")
+    assert shown_bytes(page) == good
+    settle(page)
+    assert len(refused) == 1 and page.locator("#err-general").is_hidden()
+    assert shown_bytes(page) != good
