@@ -24,7 +24,7 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     OPALINE_PORT=8000
 
 # A regular (non-editable) install: the shaders and presets ship as package data
-# (service.glsl, service.presets in pyproject.toml), so the source tree is not needed after.
+# (service/_glsl, service/_presets in pyproject.toml), so the source tree is not needed after.
 WORKDIR /tmp/opaline-src
 COPY pyproject.toml README.md ./
 COPY service ./service

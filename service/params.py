@@ -199,6 +199,11 @@ def field_doc(model: type[BaseModel], name: str) -> str:
 RANGE_ERRORS = {"less_than_equal", "greater_than_equal", "less_than", "greater_than"}
 
 
+def _shown(value: Any) -> str:
+    """A number as typed: query strings and CLI flags give numbers as text."""
+    return value if isinstance(value, str) else repr(value)
+
+
 def _tuple_length(model: type[BaseModel], name: str) -> int:
     info = model.model_fields.get(name)
     for arg in getattr(info.annotation, "__args__", ()) if info else ():
