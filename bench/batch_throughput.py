@@ -26,7 +26,6 @@ import argparse
 import json
 import os
 import platform
-import socket
 import statistics
 import subprocess
 import sys
@@ -34,11 +33,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import httpx
+from service.localserver import LocalServer
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
-HOST = "127.0.0.1"
 SIZE = 256
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere")
@@ -94,43 +92,6 @@ def measure(name: str, extra: list[str], env_extra: dict[str, str], args: argpar
           f"{row['in_run_per_s']:6.2f}/s in run  re-run (all skipped) "
           f"{row['uptodate_rerun_s']:.2f} s", flush=True)
     return row
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind((HOST, 0))
-        return sock.getsockname()[1]
-
-
-def start_server(workers: int) -> tuple[subprocess.Popen, str]:
-    port = free_port()
-    env = {**os.environ}
-    server = subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "serve", "--host", HOST, "--port", str(port),
-         "--workers", str(workers), "--log-level", "warning"],
-        cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    url = f"http://{HOST}:{port}"
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        if server.poll() is not None:
-            raise RuntimeError(f"opaline serve exited: {server.stderr.read()[-2000:]}")
-        try:
-            if httpx.get(f"{url}/readyz", timeout=2).status_code == 200:
-                return server, url
-        except httpx.TransportError:
-            pass
-        time.sleep(0.2)
-    server.terminate()
-    raise RuntimeError("opaline serve was not ready within 60 s")
-
-
-def stop_server(server: subprocess.Popen) -> None:
-    server.terminate()
-    try:
-        server.wait(timeout=20)
-    except subprocess.TimeoutExpired:
-        server.kill()
-        server.wait(timeout=10)
 
 
 def gl_renderer() -> str:
@@ -195,13 +156,11 @@ def main() -> None:
         result["server_note"] = "`--server`: not measured (service/serve.py absent or skipped)."
         print(result["server_note"])
     else:
-        server, url = start_server(workers=1)
-        try:
+        with LocalServer(workers=1) as server:
             for jobs, salt in ((2, 300), (4, 400)):
                 rows.append(measure(f"--server (serve --workers 1), --jobs {jobs}",
-                                    ["--server", url, "--jobs", str(jobs)], {}, args, salt))
-        finally:
-            stop_server(server)
+                                    ["--server", server.base, "--jobs", str(jobs)], {}, args,
+                                    salt))
     result["load_after"] = " ".join(f"{x:.2f}" for x in os.getloadavg())
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "batch_throughput.json").write_text(json.dumps(result, indent=2) + "\n")

@@ -21,12 +21,8 @@ import argparse
 import json
 import os
 import platform
-import signal
-import socket
 import statistics
-import subprocess
 import sys
-import tempfile
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -34,57 +30,18 @@ from pathlib import Path
 
 import httpx
 
+from service.localserver import LocalServer
+
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
-HOST = "127.0.0.1"
 SIZE = 256
 PHASE_LIMIT_S = 120.0  # no phase runs longer than this
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind((HOST, 0))
-        return sock.getsockname()[1]
-
-
-class Server:
-    """``opaline serve`` in a subprocess on loopback, stopped on exit."""
-
-    def __init__(self, workers: int, queue_size: int) -> None:
-        self.port = free_port()
-        self.base = f"http://{HOST}:{self.port}"
-        env = {**os.environ, "OPALINE_QUEUE_SIZE": str(queue_size), "OPALINE_DEADLINE_S": "120",
-               "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-        self.log = tempfile.TemporaryFile("w+")  # a pipe left unread could stall the server
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--host", HOST, "--port",
-             str(self.port), "--workers", str(workers), "--log-level", "warning"],
-            cwd=ROOT, env=env, stdout=self.log, stderr=subprocess.STDOUT)
-
-    def __enter__(self) -> Server:
-        end = time.monotonic() + 60
-        while time.monotonic() < end:
-            if self.proc.poll() is not None:
-                self.log.seek(0)
-                raise RuntimeError(f"server exited: {self.log.read()}")
-            try:
-                if httpx.get(f"{self.base}/readyz", timeout=2).status_code == 200:
-                    return self
-            except httpx.TransportError:
-                pass
-            time.sleep(0.1)
-        self.__exit__()
-        raise RuntimeError("server not ready within 60 s")
-
-    def __exit__(self, *exc: object) -> None:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-            try:
-                self.proc.wait(20)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(5)
-        self.log.close()
+def local_service(workers: int, queue_size: int) -> LocalServer:
+    """The service with a queue deep enough for the whole run and a generous deadline."""
+    return LocalServer(workers, env={"OPALINE_QUEUE_SIZE": str(queue_size),
+                                     "OPALINE_DEADLINE_S": "120"})
 
 
 def percentile(values: list[float], q: float) -> float:
@@ -148,7 +105,7 @@ def hits_while(client: httpx.Client, url: str, busy: threading.Thread, limit: in
 
 def measure(workers: int, misses: int, hits: int, concurrency: int) -> list[dict]:
     rows = []
-    with Server(workers, queue_size=max(64, misses)) as server, httpx.Client(
+    with local_service(workers, queue_size=max(64, misses)) as server, httpx.Client(
             base_url=server.base, timeout=httpx.Timeout(60.0),
             limits=httpx.Limits(max_connections=2 * concurrency)) as client:
         hit_url = f"/v1/render?preset=cd-rom&width={SIZE}&height={SIZE}"

@@ -2,72 +2,30 @@
 
 from __future__ import annotations
 
-import os
 import signal
-import socket
-import subprocess
-import sys
-import time
 from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
 import httpx
 import pytest
 
+from service.localserver import LocalServer, ServerError
+
 pytestmark = pytest.mark.gl
 
-ROOT = Path(__file__).resolve().parent.parent
-HOST = "127.0.0.1"
 QUEUE = 2
 BURST = 24  # distinct renders at once: far more than one worker and a queue of 2 hold
 TIMEOUT = httpx.Timeout(30.0, connect=5.0)
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind((HOST, 0))
-        return sock.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
-def server(backend, tmp_path_factory):
-    port = free_port()
-    log = (tmp_path_factory.mktemp("server") / "server.log").open("w+")
-    env = {**os.environ, "OPALINE_GL_BACKEND": backend, "OPALINE_QUEUE_SIZE": str(QUEUE),
-           "OPALINE_DEADLINE_S": "5", "OPALINE_WARMUP": "false",
-           "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "serve", "--host", HOST, "--port", str(port),
-         "--workers", "1", "--log-level", "warning"],
-        cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
-    base = f"http://{HOST}:{port}"
+def server(backend):
+    env = {"OPALINE_GL_BACKEND": backend, "OPALINE_QUEUE_SIZE": str(QUEUE),
+           "OPALINE_DEADLINE_S": "5", "OPALINE_WARMUP": "false"}
     try:
-        wait_ready(base, proc, log)
-        yield base, proc, log
-    finally:
-        if proc.poll() is None:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(15)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(5)
-        log.close()
-
-
-def wait_ready(base: str, proc: subprocess.Popen, log) -> None:
-    end = time.monotonic() + 60
-    while time.monotonic() < end:
-        if proc.poll() is not None:
-            log.seek(0)
-            pytest.fail(f"server exited with {proc.returncode}:\n{log.read()}")
-        try:
-            if httpx.get(f"{base}/readyz", timeout=2).status_code == 200:
-                return
-        except httpx.TransportError:
-            pass
-        time.sleep(0.1)
-    pytest.fail("server not ready within 60 s")
+        with LocalServer(workers=1, env=env) as local:
+            yield local.base, local.proc, local.log
+    except ServerError as exc:
+        pytest.fail(str(exc))
 
 
 def test_ready_over_http(server):

@@ -3,18 +3,13 @@
 from __future__ import annotations
 
 import base64
-import os
 import shlex
-import socket
 import subprocess
-import sys
-import tempfile
-import time
-import urllib.error
-import urllib.request
 from pathlib import Path
 
 import pytest
+
+from service.localserver import LocalServer, ServerError, loopback_env
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = Path("/usr/bin/chromium")
@@ -24,64 +19,19 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-sync"]
 WAIT_MS = 15_000  # the longest any one step may take in the browser
 START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up render
-PROXY_VARS = {"http_proxy", "https_proxy", "all_proxy", "HTTP_PROXY", "HTTPS_PROXY", "ALL_PROXY"}
 
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(),
                                 reason=f"{CHROMIUM} is missing (Debian's chromium package)")
 
 
-def local_env(**extra: str) -> dict[str, str]:
-    """The environment without proxies: every request here goes to 127.0.0.1."""
-    env = {k: v for k, v in os.environ.items() if k not in PROXY_VARS}
-    return {**env, "NO_PROXY": "127.0.0.1,localhost", "no_proxy": "127.0.0.1,localhost", **extra}
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def wait_healthy(base: str, proc: subprocess.Popen, log: Path) -> None:
-    opener = urllib.request.build_opener(urllib.request.ProxyHandler({}))
-    deadline = time.monotonic() + START_S
-    while time.monotonic() < deadline:
-        if proc.poll() is not None:
-            pytest.fail(f"the service exited with {proc.returncode}:\n{log.read_text()[-3000:]}")
-        try:
-            with opener.open(f"{base}/healthz", timeout=2) as resp:
-                if resp.status == 200:
-                    return
-        except (urllib.error.URLError, OSError):
-            pass
-        time.sleep(0.2)
-    pytest.fail(f"the service did not answer /healthz in {START_S:.0f} s:\n"
-                f"{log.read_text()[-3000:]}")
-
-
 @pytest.fixture(scope="module")
 def server():
     """``opaline serve`` as a real uvicorn process on a free port of 127.0.0.1."""
-    port = free_port()
-    with tempfile.TemporaryDirectory() as tmp:
-        log = Path(tmp) / "serve.log"
-        with log.open("wb") as out:
-            proc = subprocess.Popen(
-                [sys.executable, "-m", "service.cli", "serve", "--host", "127.0.0.1",
-                 "--port", str(port), "--workers", "1", "--log-level", "warning"],
-                cwd=ROOT, env=local_env(PYTHONPATH=str(ROOT)), stdout=out,
-                stderr=subprocess.STDOUT)
-        base = f"http://127.0.0.1:{port}"
-        try:
-            wait_healthy(base, proc, log)
-            yield base
-        finally:
-            proc.terminate()
-            try:
-                proc.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(timeout=5)
+    try:
+        with LocalServer(workers=1, ready_path="/healthz", start_timeout_s=START_S) as local:
+            yield local.base
+    except ServerError as exc:
+        pytest.fail(str(exc))
 
 
 @pytest.fixture(scope="module")
@@ -213,7 +163,7 @@ def test_copied_curl_returns_the_shown_bytes(page, tmp_path):
     command = shlex.split(page.input_value("#copy-curl"))
     assert command[0] == "curl" and "-o" in command
     out = tmp_path / command[command.index("-o") + 1]
-    run = subprocess.run(command, cwd=tmp_path, env=local_env(), capture_output=True,
+    run = subprocess.run(command, cwd=tmp_path, env=loopback_env(), capture_output=True,
                          timeout=30, check=False)
     assert run.returncode == 0, run.stderr.decode()
     assert out.read_bytes() == shown
