@@ -5,7 +5,7 @@
 Each route parses its input into the models of ``service.params``, resolves
 it to a ``Job`` (``service.request``), answers from the cache or through the
 worker pool (``service.worker``), and leaves every failure to the handlers
-of ``PUBLIC_ERRORS``, which give each a public face: 422 with one line per
+of ``service.errors``, which give each a public face: 422 with one line per
 problem, 404 for an unknown preset, 413, 503 with Retry-After, 500 with an
 incident id (the traceback goes only to the server log).
 """
@@ -18,82 +18,30 @@ from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Query, Request
-from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, Field, ValidationError, field_validator
-from starlette.exceptions import HTTPException
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from pydantic import BaseModel, Field
 
 from . import __version__
 from .cache import ImageCache, etag, matches, mdf_key
 from .camera import key_light_direction
 from .encode import EXTENSIONS, MEDIA_TYPES
+from .errors import ERROR_RESPONSES, LimitError, Problem, install
 from .metrics import Metrics
-from .params import (
-    MATERIAL_FIELDS,
-    Material,
-    MaterialFields,
-    Pixels,
-    RenderRequest,
-    Unit,
-    describe_errors,
-    wavelengths_ok,
-)
-from .presets import Preset, UnknownPreset, all_presets, get_preset
+from .params import MATERIAL_FIELDS, Material, RenderRequest
+from .presets import Preset, all_presets, get_preset
+from .queries import MdfQuery, RenderQuery
 from .renderer import Renderer
 from .request import TIERS, CostError, Job, check_cost, resolve
 from .settings import Settings, SettingsDep, get_settings
 from .spectrum import rgb_weights
-from .worker import (
-    DeadlineExceeded,
-    Overloaded,
-    RenderFailed,
-    Unavailable,
-    WorkerPool,
-    image_task,
-    mdf_task,
-)
+from .worker import WorkerPool, image_task, mdf_task
 
 WEB_DIR = Path(__file__).resolve().parent / "web"
 MDF_LABEL = "mdf-plot"  # the render-latency label of MDF plots
-
-
-# Query-string forms of the request models
-
-
-def _comma_list(value: Any) -> Any:
-    """``albedo=0.1,0.2,0.3`` (or the parameter repeated three times) → three values."""
-    if isinstance(value, list) and len(value) == 1 and isinstance(value[0], str):
-        value = value[0]
-    return value.split(",") if isinstance(value, str) else value
-
-
-class RenderQuery(RenderRequest):
-    """A render request in a query string."""
-
-    albedo: tuple[Unit, Unit, Unit] | None = Field(
-        None, description="Diffuse colour, linear RGB, each 0 … 1, written R,G,B.")
-
-    _albedo = field_validator("albedo", mode="before")(_comma_list)
-
-
-class MdfQuery(MaterialFields):
-    """An MDF plot: the material, the plot size and format, the wavelength count."""
-
-    albedo: tuple[Unit, Unit, Unit] | None = Field(
-        None, description="Diffuse colour (unused by the plot), linear RGB, each 0 … 1, R,G,B.")
-    size: Pixels = Field(256, description="Plot size N (an N×N image), 16 … 2048.")
-    format: Literal["png", "npy"] = Field(
-        "png", description="'png' (normalised by the maximum, sRGB) or 'npy' (linear D, float32).")
-    wavelengths: int = Field(
-        0, description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
-
-    _albedo = field_validator("albedo", mode="before")(_comma_list)
-    _wavelengths = field_validator("wavelengths")(wavelengths_ok)
 
 
 class PresetInfo(BaseModel):
@@ -111,118 +59,6 @@ class PresetInfo(BaseModel):
     key_light: dict[str, float] | None = Field(
         None, description="Where the preset puts its key light, in degrees, as light_azimuth "
         "and light_elevation measure them.")
-
-
-class Problem(BaseModel):
-    detail: str
-
-
-class Problems(BaseModel):
-    detail: list[str] = Field(description="One line per problem: field, value, allowed range.")
-
-
-# Public errors
-
-
-class LimitError(ValueError):
-    """A request within the parameter ranges but over this service's configured limits."""
-
-    def __init__(self, problems: list[str]) -> None:
-        super().__init__("; ".join(problems))
-        self.problems = problems
-
-
-PUBLIC_ERRORS: dict[type[Exception], tuple[int, str | None]] = {
-    UnknownPreset: (404, "unknown_preset"),
-    CostError: (422, "cost"),
-    LimitError: (422, "invalid"),
-    ValidationError: (422, "invalid"),
-    Overloaded: (503, "queue_full"),
-    DeadlineExceeded: (503, "deadline"),
-    Unavailable: (503, "unavailable"),
-    RenderFailed: (500, None),
-}
-
-
-def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> list[str]:
-    """describe_errors' lines for FastAPI's errors, whose locations start with 'body'/'query'."""
-    lines, rest = [], []
-    for err in errors:
-        loc = tuple(err.get("loc", ()))
-        loc = loc[1:] if loc and loc[0] in ("body", "query", "path") else loc
-        if err["type"] == "json_invalid":
-            reason = (err.get("ctx") or {}).get("error", "")
-            lines.append(f"body: not valid JSON ({reason})" if reason else "body: not valid JSON")
-        elif not loc and err["type"] == "missing":
-            lines.append("body: a JSON object is required ({} renders the defaults)")
-        else:
-            rest.append({**err, "loc": () if loc and isinstance(loc[0], int) else loc})
-
-    class _Errors:  # the one method describe_errors reads from a ValidationError
-        @staticmethod
-        def errors() -> list[dict[str, Any]]:
-            return rest
-
-    return lines + describe_errors(_Errors(), model)  # type: ignore[arg-type]
-
-
-def _problem(status: int, detail: str | list[str], headers: dict[str, str] | None = None):
-    return JSONResponse({"detail": detail}, status_code=status, headers=headers)
-
-
-async def on_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
-    request.app.state.metrics.reject("invalid")
-    model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
-    return _problem(422, _validation_lines(list(exc.errors()), model))
-
-
-async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
-    status, reason = next(v for k, v in PUBLIC_ERRORS.items() if isinstance(exc, k))
-    state = request.app.state
-    if reason:
-        state.metrics.reject(reason)
-    if isinstance(exc, ValidationError):
-        return _problem(status, describe_errors(exc))
-    if isinstance(exc, LimitError):
-        return _problem(status, exc.problems)
-    if isinstance(exc, RenderFailed):
-        return _problem(status, f"{exc}: the details are in the server log")
-    if status == 503:
-        retry = str(state.settings.retry_after_s)
-        return _problem(status, f"{exc}; retry later", headers={"Retry-After": retry})
-    return _problem(status, [str(exc)] if status == 422 else str(exc))
-
-
-class BodyLimit:
-    """413 for a body over ``limit`` bytes: by its Content-Length, or counted as it arrives."""
-
-    def __init__(self, app: ASGIApp, limit: int, on_reject: Any) -> None:
-        self.app, self.limit, self.on_reject = app, limit, on_reject
-
-    def _refuse(self) -> HTTPException:
-        self.on_reject()
-        return HTTPException(413, f"request body over the {self.limit} byte limit")
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        declared = dict(scope["headers"]).get(b"content-length", b"")
-        if declared.isdigit() and int(declared) > self.limit:
-            exc = self._refuse()
-            await _problem(413, exc.detail)(scope, receive, send)
-            return
-        seen = 0
-
-        async def counted() -> Message:
-            nonlocal seen
-            message = await receive()
-            seen += len(message.get("body", b""))
-            if seen > self.limit:
-                raise self._refuse()  # FastAPI re-raises HTTPException from its body reader
-            return message
-
-        await self.app(scope, counted, send)
 
 
 # Services the routes depend on
@@ -302,13 +138,6 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
 # Routes
 
 IMAGE = {"schema": {"type": "string", "format": "binary"}}
-RETRY_AFTER = {"Retry-After": {"description": "Seconds to wait before retrying.",
-                               "schema": {"type": "integer"}}}
-ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
-    422: {"model": Problems, "description": "Invalid parameters, or over a configured limit."},
-    503: {"model": Problem, "description": "Overloaded or no GL context.", "headers": RETRY_AFTER},
-    500: {"model": Problem, "description": "The render failed (details in the server log)."},
-}
 CONDITIONAL: dict[int | str, dict[str, Any]] = {
     304: {"description": "Not modified: If-None-Match matched the ETag."}}
 RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
@@ -458,11 +287,7 @@ def create_app(settings: Settings | None = None,
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
-    app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
-                       on_reject=partial(metrics.reject, "too_large"))
-    app.add_exception_handler(RequestValidationError, on_invalid)
-    for exc_type in PUBLIC_ERRORS:
-        app.add_exception_handler(exc_type, on_public_error)
+    install(app, settings.max_body_bytes, metrics)
     app.include_router(router)
     mount_web(app)
     return app

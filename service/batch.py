@@ -19,7 +19,6 @@ import json
 import multiprocessing
 import os
 import signal
-import sys
 import threading
 import time
 from collections import deque
@@ -44,7 +43,12 @@ from .materials import Item, collect
 from .params import RenderRequest, describe_errors
 from .pipeline import DEFAULT_COST_BUDGET
 from .presets import UnknownPreset, get_preset
+from .progress import PlainProgress, make_progress
+from .progress import RichProgress as RichProgress  # re-exported: batch.RichProgress
+from .progress import use_rich as use_rich  # re-exported: batch.use_rich
 from .request import CostError, Job, check_cost, resolve
+from .sheet import THUMB as THUMB  # re-exported: batch.THUMB
+from .sheet import write_contact_sheet
 
 
 @dataclass
@@ -257,96 +261,6 @@ def finish(task: Task, future: Future) -> None:
     task.status = "rendered"
 
 
-# Progress: a rich bar on a terminal, plain lines in logs and CI.
-
-def use_rich(stream: Any, env: Any = os.environ) -> bool:
-    in_ci = env.get("CI", "").strip().lower() not in ("", "0", "false", "no")
-    return bool(getattr(stream, "isatty", lambda: False)()) and not in_ci
-
-
-class PlainProgress:
-    """One line per finished item, with the rate and the time left."""
-
-    def __init__(self, stream: Any = None) -> None:
-        self.stream = stream or sys.stdout
-        self.total = self.done = 0
-        self.started = time.monotonic()
-
-    def start(self, tasks: list[Task]) -> None:
-        self.total = sum(t.status == "pending" for t in tasks)
-        self.started = time.monotonic()
-        skipped = sum(t.status == "skipped" for t in tasks)
-        if skipped:
-            self.line(f"skipped {skipped} up to date")
-        for task in tasks:
-            if task.status == "failed":
-                self.line(f"failed  {task.item.name}: {task.error}")
-        if self.total:
-            self.line(f"rendering {self.total} of {len(tasks)}")
-
-    def advance(self, task: Task) -> None:
-        self.done += 1
-        rate = self.done / max(time.monotonic() - self.started, 1e-9)
-        eta = (self.total - self.done) / rate
-        width = len(str(self.total))
-        text = f"[{self.done:>{width}}/{self.total}] {task.status:<8} {task.item.name}"
-        if task.status == "failed":
-            text += f": {task.error}"
-        self.line(f"{text} ({task.seconds:.2f} s; {rate:.2f}/s, ETA {eta:.0f} s)")
-
-    def line(self, text: str) -> None:
-        print(text, file=self.stream, flush=True)
-
-    def close(self) -> None:
-        pass
-
-
-class RichProgress(PlainProgress):
-    """A progress bar with the count, the rate and the ETA; failures printed above it."""
-
-    def start(self, tasks: list[Task]) -> None:
-        from rich.console import Console
-        from rich.progress import (
-            BarColumn,
-            MofNCompleteColumn,
-            Progress,
-            ProgressColumn,
-            TextColumn,
-            TimeElapsedColumn,
-            TimeRemainingColumn,
-        )
-        from rich.text import Text
-
-        class RateColumn(ProgressColumn):
-            def render(self, task: Any) -> Text:
-                speed = task.finished_speed or task.speed
-                return Text(f"{speed:.1f}/s" if speed else "–/s", style="progress.data.speed")
-
-        console = Console(file=self.stream)
-        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                            RateColumn(), TimeElapsedColumn(), TextColumn("ETA"),
-                            TimeRemainingColumn(), console=console)
-        super().start(tasks)
-        self.bar_task = self.bar.add_task("rendering", total=self.total)
-        self.bar.start()
-
-    def advance(self, task: Task) -> None:
-        if task.status == "failed":
-            self.line(f"failed  {task.item.name}: {task.error}")
-        self.bar.advance(self.bar_task)
-
-    def line(self, text: str) -> None:
-        self.bar.console.print(text, markup=False, highlight=False)
-
-    def close(self) -> None:
-        self.bar.stop()
-
-
-def make_progress(stream: Any = None) -> PlainProgress:
-    stream = stream or sys.stderr
-    return RichProgress(stream) if use_rich(stream) else PlainProgress(sys.stdout)
-
-
 # The run.
 
 def run_batch(inputs: list[str | Path], options: Options,
@@ -371,8 +285,7 @@ def run_batch(inputs: list[str | Path], options: Options,
     progress.close()
     summary = write_summary(summary_path, tasks, options, started, interrupted=False)
     if options.sheet:
-        write_index(options.out, tasks)
-        write_sheet(options.out, tasks)
+        write_contact_sheet(options.out, tasks)
     return summary
 
 
@@ -426,116 +339,36 @@ def _raise_interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
-# Contact sheet: DIR/index.html and DIR/sheet.png.
-
-THUMB = 128
-LABEL = 18
-
-
-def thumbnail(path: Path) -> Any:
-    """An RGB thumbnail of a PNG or a linear .npy output, THUMB pixels on its longer side."""
-    import numpy as np
-    from PIL import Image
-
-    if path.suffix == ".npy":
-        from .reference import srgb_encode
-
-        linear = np.load(path)
-        rgb = srgb_encode(np.clip(linear[..., :3], 0.0, 1.0))
-        image = Image.fromarray(np.rint(rgb * 255).astype(np.uint8), "RGB")
-    else:
-        with Image.open(path) as opened:
-            image = opened.convert("RGBA")
-        backdrop = Image.new("RGBA", image.size, (40, 40, 40, 255))
-        image = Image.alpha_composite(backdrop, image).convert("RGB")
-    scale = THUMB / max(image.size)
-    size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
-    return image.resize(size, Image.Resampling.LANCZOS)
-
-
-def write_sheet(out: Path, tasks: list[Task]) -> Path:
-    """A grid of every thumbnail with its name drawn under it; failures as red cells."""
-    import io
-    import math
-
-    from PIL import Image, ImageDraw, ImageFont
-
-    shown = [t for t in tasks if t.status in ("rendered", "skipped", "failed")]
-    columns = max(1, min(8, math.ceil(math.sqrt(len(shown) or 1))))
-    rows = max(1, math.ceil(len(shown) / columns))
-    cell_w, cell_h = THUMB + 8, THUMB + LABEL + 8
-    sheet = Image.new("RGB", (columns * cell_w, rows * cell_h), (24, 24, 24))
-    draw = ImageDraw.Draw(sheet)
-    font = ImageFont.load_default()
-    for index, task in enumerate(shown):
-        x, y = (index % columns) * cell_w + 4, (index // columns) * cell_h + 4
-        if task.status == "failed" or task.output is None:
-            draw.rectangle((x, y, x + THUMB - 1, y + THUMB - 1), fill=(110, 20, 20))
-            draw.text((x + 6, y + 6), "failed", fill=(255, 220, 220), font=font)
-        else:
-            thumb = thumbnail(task.output)
-            sheet.paste(thumb, (x + (THUMB - thumb.width) // 2, y + (THUMB - thumb.height) // 2))
-        draw.text((x, y + THUMB + 3), _fit(draw, task.item.name, font), fill=(230, 230, 230),
-                  font=font)
-    data = io.BytesIO()
-    sheet.save(data, format="PNG")
-    write_atomic(out / "sheet.png", data.getvalue())
-    return out / "sheet.png"
-
-
-def _fit(draw: Any, text: str, font: Any) -> str:
-    if draw.textlength(text, font=font) <= THUMB:
-        return text
-    while text and draw.textlength(text + "…", font=font) > THUMB:
-        text = text[1:]
-    return "…" + text
-
-
-def write_index(out: Path, tasks: list[Task]) -> Path:
-    """An HTML page of the thumbnails with their names, and the failures with their reasons."""
-    from html import escape
-    from urllib.parse import quote
-
-    figures, failures = [], []
-    for task in tasks:
-        name = escape(task.item.name)
-        if task.status == "failed" or task.output is None:
-            failures.append(f"<li><b>{name}</b>: {escape(task.error or task.status)}</li>")
-            continue
-        if task.status not in ("rendered", "skipped"):
-            continue
-        href = quote(task.output.relative_to(out).as_posix())
-        body = (f'<img src="{href}" alt="{name}" loading="lazy">' if task.output.suffix == ".png"
-                else f'<a href="{href}">{escape(task.output.name)}</a>')
-        figures.append(f"<figure>{body}<figcaption>{name}</figcaption></figure>")
-    failed = (f"<h2>Failed ({len(failures)})</h2><ul>{''.join(failures)}</ul>"
-              if failures else "")
-    page = INDEX_TEMPLATE.format(count=len(figures), figures="\n".join(figures), failed=failed)
-    write_atomic(out / "index.html", page.encode())
-    return out / "index.html"
-
-
-INDEX_TEMPLATE = """<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><title>Opaline thumbnails</title>
-<style>
-body {{ font: 14px system-ui, sans-serif; background: #181818; color: #eee; margin: 2em; }}
-main {{ display: grid; grid-template-columns: repeat(auto-fill, minmax(150px, 1fr)); gap: 1em; }}
-figure {{ margin: 0; text-align: center; }}
-img {{ max-width: 128px; max-height: 128px; image-rendering: auto; }}
-figcaption {{ word-break: break-all; }} li {{ margin: .3em 0; }}
-</style></head><body>
-<h1>Opaline thumbnails ({count})</h1>
-<main>
-{figures}
-</main>
-{failed}
-</body></html>
-"""
-
-
 # Command line.
 
 def cmd_batch(args: argparse.Namespace) -> None:
+    options = options_from_args(args)
+    with _term_as_interrupt():
+        summary = run_batch(args.inputs, options)
+    counts = summary["counts"]
+    where = options.summary or options.out / "summary.json"
+    print(f"opaline batch: {counts['rendered']} rendered, {counts['skipped']} skipped, "
+          f"{counts['failed']} failed in {summary['seconds']:.1f} s; summary: {where}")
+    if counts["failed"]:
+        raise SystemExit(1)
+
+
+def options_from_args(args: argparse.Namespace) -> Options:
+    """The batch's options, every override and limit checked before any input is read."""
+    overrides = overrides_from_args(args)
+    if args.server and not args.server.startswith(("http://", "https://")):
+        raise CliError(f"--server {args.server!r}: expected an http:// or https:// URL")
+    jobs = args.jobs if args.jobs is not None else (4 if args.server else 1)
+    if not 1 <= jobs <= 64:
+        raise CliError(f"--jobs={jobs} is out of range: allowed [1 … 64]")
+    return Options(out=Path(args.out), jobs=jobs, overrides=overrides, server=args.server,
+                   backend=args.backend, sheet=args.sheet,
+                   summary=Path(args.summary) if args.summary else None, force=args.force,
+                   retries=args.retries)
+
+
+def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
+    """--size, --format and --quality as request fields, validated by the request model."""
     overrides: dict[str, Any] = {}
     if args.size:
         overrides["width"], overrides["height"] = parse_size(args.size)
@@ -547,23 +380,7 @@ def cmd_batch(args: argparse.Namespace) -> None:
         RenderRequest.model_validate(overrides)
     except ValidationError as exc:
         raise CliError("; ".join(describe_errors(exc))) from None
-    if args.server and not args.server.startswith(("http://", "https://")):
-        raise CliError(f"--server {args.server!r}: expected an http:// or https:// URL")
-    jobs = args.jobs if args.jobs is not None else (4 if args.server else 1)
-    if not 1 <= jobs <= 64:
-        raise CliError(f"--jobs={jobs} is out of range: allowed [1 … 64]")
-    options = Options(out=Path(args.out), jobs=jobs, overrides=overrides, server=args.server,
-                      backend=args.backend, sheet=args.sheet,
-                      summary=Path(args.summary) if args.summary else None, force=args.force,
-                      retries=args.retries)
-    with _term_as_interrupt():
-        summary = run_batch(args.inputs, options)
-    counts = summary["counts"]
-    where = options.summary or options.out / "summary.json"
-    print(f"opaline batch: {counts['rendered']} rendered, {counts['skipped']} skipped, "
-          f"{counts['failed']} failed in {summary['seconds']:.1f} s; summary: {where}")
-    if counts["failed"]:
-        raise SystemExit(1)
+    return overrides
 
 
 def register(sub: argparse._SubParsersAction) -> None:
