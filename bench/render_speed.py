@@ -60,7 +60,7 @@ def measure(backend: str, repeats: int) -> dict:
 def markdown(results: list[dict], repeats: int) -> str:
     lines = [
         f"Machine: {platform.machine()}, {platform.system()}, Python {platform.python_version()}; "
-        f"median of {repeats} warm renders, standard tier (4 samples, analytic AA).",
+        f"median of {repeats} warm renders, standard tier (4 samples).",
         "",
         "| backend | size | draw + readback, median over presets (ms) | slowest preset (ms) "
         "| PNG encode (ms) |",

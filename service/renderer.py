@@ -203,6 +203,7 @@ class Renderer:
                 ],
                 "u_light_irradiance": [tuple(light.irradiance) for light in lights],
                 "u_ambient": tuple(preset.ambient),
+                "u_aa_scale": 1.0 / np.sqrt(len(offsets)),
             }
         )
         if normal_map is not None:
@@ -271,7 +272,7 @@ class Renderer:
         program = self.programs.get("mdf_plot.glsl", defines)
         targets = self.targets((size, size))
         uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
-        program["u_size"].value = size
+        uniforms.apply(program, {"u_size": size, "u_aa_scale": 1.0})
         targets.display_fbo.use()
         self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
         self.fullscreen(program)
