@@ -27,12 +27,12 @@ def parameter_help() -> str:
     for name, info in RenderRequest.model_fields.items():
         if name == "preset":
             continue
+        desc = info.description or ""
         allowed = field_range(RenderRequest, name)
-        desc = (info.description or "").split(", -2π")[0]
-        lines.append(
-            f"  {name:<16} {desc}"
-            + (f" Range {allowed}." if allowed and allowed not in desc else "")
-        )
+        # Descriptions state their range in words; add the bounds where one does not.
+        if allowed and "…" not in desc:
+            desc += f" Range {allowed}."
+        lines.append(f"  {name:<16} {desc}")
     return "\n".join(lines)
 
 

@@ -253,10 +253,11 @@ def describe_errors(exc: ValidationError, model: type[BaseModel] = RenderRequest
         elif kind == "missing":
             lines.append(f"{where}: required field missing")
         elif kind in RANGE_ERRORS and allowed:
-            lines.append(f"{where}={given!r} is out of range: allowed {allowed}")
+            lines.append(f"{where}={_shown(given)} is out of range: allowed {allowed}")
         elif kind == "finite_number":
             lines.append(
-                f"{where}={given!r} must be a finite number" + (f" in {allowed}" if allowed else "")
+                f"{where}={_shown(given)} must be a finite number"
+                + (f" in {allowed}" if allowed else "")
             )
         else:
             msg = err["msg"].removeprefix("Value error, ")
