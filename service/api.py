@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Query, Request
-from fastapi.responses import FileResponse, JSONResponse, RedirectResponse, Response
+from fastapi.responses import FileResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
 from pydantic import BaseModel, Field
 
@@ -38,7 +38,7 @@ from .renderer import Renderer
 from .request import TIERS, CostError, Job, check_cost, resolve
 from .settings import Settings, SettingsDep, get_settings
 from .spectrum import rgb_weights
-from .worker import WorkerPool, image_task, mdf_task
+from .worker import Task, WorkerPool, image_task, mdf_task
 
 WEB_DIR = Path(__file__).resolve().parent / "web"
 MDF_LABEL = "mdf-plot"  # the render-latency label of MDF plots
@@ -59,6 +59,18 @@ class PresetInfo(BaseModel):
     key_light: dict[str, float] | None = Field(
         None, description="Where the preset puts its key light, in degrees, as light_azimuth "
         "and light_elevation measure them.")
+
+
+class Readiness(BaseModel):
+    """What /readyz answers, with 200 or 503 alike."""
+
+    ready: bool
+    backend: str | None = Field(description="GL backend of the first ready worker.")
+    renderer: str | None = Field(description="GL renderer string of the first ready worker.")
+    queue_depth: int = Field(description="Jobs waiting for a render worker.")
+    workers: list[dict[str, Any]] = Field(
+        description="Each worker: name, state, restarts, its GL context's description, and "
+        "the last error when it has no context.")
 
 
 # Services the routes depend on
@@ -84,13 +96,15 @@ def get_service(request: Request, settings: SettingsDep) -> Service:
 ServiceDep = Annotated[Service, Depends(get_service)]
 
 
+def _over_limit(name: str, value: int, limit: int) -> str:
+    return f"{name}={value} is out of range: allowed [16 … {limit}] on this service"
+
+
 def check_limits(job: Job, settings: Settings) -> None:
-    problems = [
-        f"{name}={value} is out of range: allowed [16 … {limit}] on this service"
-        for name, value, limit in (("width", job.width, settings.max_width),
-                                   ("height", job.height, settings.max_height))
-        if value > limit
-    ]
+    problems = [_over_limit(name, value, limit)
+                for name, value, limit in (("width", job.width, settings.max_width),
+                                           ("height", job.height, settings.max_height))
+                if value > limit]
     if problems:
         raise LimitError(problems)
     check_cost(job, settings.cost_budget)
@@ -99,15 +113,14 @@ def check_limits(job: Job, settings: Settings) -> None:
 def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     size = min(settings.max_width, settings.max_height)
     if params.size > size:
-        raise LimitError([f"size={params.size} is out of range: allowed [16 … {size}] "
-                          "on this service"])
+        raise LimitError([_over_limit("size", params.size, size)])
     cost = params.size * params.size * max(params.wavelengths, 3)
     if cost > settings.cost_budget:
         raise CostError(f"cost={cost} (size²×max(wavelengths, 3)) is over the budget of "
                         f"{settings.cost_budget}: lower the size or wavelengths")
 
 
-async def answer_image(svc: Service, request: Request, key: str, task: Any, label: str,
+async def answer_image(svc: Service, request: Request, key: str, task: Task, label: str,
                        fmt: str, filename: str) -> Response:
     """The image under ``key``: 304, from the cache, or rendered by a worker."""
     tag = etag(key, svc.pool.identity)
@@ -138,18 +151,21 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
 # Routes
 
 IMAGE = {"schema": {"type": "string", "format": "binary"}}
+ETAG = {"ETag": {"description": "Strong validator of this image as this service draws it; "
+                                "a GET that sends it back in If-None-Match gets 304.",
+                 "schema": {"type": "string"}}}
 CONDITIONAL: dict[int | str, dict[str, Any]] = {
     304: {"description": "Not modified: If-None-Match matched the ETag."}}
 RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
     404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
     413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
 }
 MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
     **CONDITIONAL, **ERROR_RESPONSES,
 }
 router = APIRouter()
@@ -212,14 +228,14 @@ async def healthz() -> dict[str, str]:
 
 
 @router.get("/readyz", tags=["operations"], summary="A render worker has a live GL context",
-            responses={503: {"description": "No worker has a GL context."}})
-async def readyz(svc: ServiceDep) -> JSONResponse:
+            responses={503: {"model": Readiness, "description": "No worker has a GL context."}})
+async def readyz(svc: ServiceDep, response: Response) -> Readiness:
     workers = svc.pool.status()
     ready = next((w for w in workers if w["state"] == "ready"), None)
-    body = {"ready": ready is not None, "backend": (ready or {}).get("backend"),
-            "renderer": (ready or {}).get("renderer"), "queue_depth": svc.pool.depth(),
-            "workers": workers}
-    return JSONResponse(body, status_code=200 if ready else 503)
+    response.status_code = 200 if ready else 503
+    return Readiness(ready=ready is not None, backend=(ready or {}).get("backend"),
+                     renderer=(ready or {}).get("renderer"), queue_depth=svc.pool.depth(),
+                     workers=workers)
 
 
 @router.get("/metrics", tags=["operations"], summary="Prometheus metrics",
@@ -232,7 +248,7 @@ async def metrics_get(svc: ServiceDep) -> Response:
 # The app
 
 
-def warmup_task():
+def warmup_task() -> Task:
     """Compile the default preset's shaders and load the CIE tables before the first request."""
     job = resolve(RenderRequest(width=16, height=16, quality="draft"))
     draw = image_task(job, get_preset(job.preset))

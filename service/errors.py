@@ -124,9 +124,10 @@ class BodyLimit:
     def __init__(self, app: ASGIApp, limit: int, on_reject: Any) -> None:
         self.app, self.limit, self.on_reject = app, limit, on_reject
 
-    def _refuse(self) -> HTTPException:
+    def _refuse(self) -> str:
+        """Count the rejection; the message to answer it with."""
         self.on_reject()
-        return HTTPException(413, f"request body over the {self.limit} byte limit")
+        return f"request body over the {self.limit} byte limit"
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -134,8 +135,7 @@ class BodyLimit:
             return
         declared = dict(scope["headers"]).get(b"content-length", b"")
         if declared.isdigit() and int(declared) > self.limit:
-            exc = self._refuse()
-            await _problem(413, exc.detail)(scope, receive, send)
+            await _problem(413, self._refuse())(scope, receive, send)
             return
         seen = 0
 
@@ -144,7 +144,8 @@ class BodyLimit:
             message = await receive()
             seen += len(message.get("body", b""))
             if seen > self.limit:
-                raise self._refuse()  # FastAPI re-raises HTTPException from its body reader
+                # FastAPI re-raises HTTPException from its body reader
+                raise HTTPException(413, self._refuse())
             return message
 
         await self.app(scope, counted, send)

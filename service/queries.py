@@ -37,8 +37,10 @@ class MdfQuery(MaterialFields):
     size: Pixels = Field(256, description="Plot size N (an N×N image), 16 … 2048.")
     format: Literal["png", "npy"] = Field(
         "png", description="'png' (normalised by the maximum, sRGB) or 'npy' (linear D, float32).")
+    # As RenderFields.wavelengths: bounds for the schema, the exact rule in the validator.
     wavelengths: int = Field(
-        0, description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
+        0, json_schema_extra={"minimum": 0, "maximum": 128},
+        description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
 
     _albedo = field_validator("albedo", mode="before")(_comma_list)
     _wavelengths = field_validator("wavelengths")(wavelengths_ok)

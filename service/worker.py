@@ -239,18 +239,20 @@ class WorkerPool:
         worker.state = "stopped"
 
     def _open(self, worker: _Worker) -> None:
+        # Nothing may escape: an exception here would end the thread without setting
+        # ``opened`` (start() then waits its whole timeout) or releasing the context.
         try:
-            renderer = self.factory()
+            worker.renderer = self.factory()
+            gl = getattr(worker.renderer, "gl", None)
+            worker.info = gl.describe() if gl is not None else {}
         except Exception as exc:  # any failure leaves the worker without GL
             log.exception("%s: no GL context", worker.name)
+            self._close(worker)
             worker.state, worker.error = "failed", f"{type(exc).__name__}: {exc}"
             return
-        worker.renderer = renderer
-        gl = getattr(renderer, "gl", None)
-        worker.info = gl.describe() if gl is not None else {}
         try:
             if self.warmup is not None:
-                self.warmup(renderer)
+                self.warmup(worker.renderer)
         except Exception as exc:
             log.exception("%s: warm-up render failed", worker.name)
             self._close(worker)
@@ -269,6 +271,11 @@ class WorkerPool:
             log.exception("%s: releasing the GL context failed", worker.name)
 
     def _serve(self, worker: _Worker, item: _Queued) -> None:
+        # A future someone cancelled is not rendered; one marked running can no longer be
+        # cancelled, so setting its result below cannot raise and end the thread.
+        if not item.future.set_running_or_notify_cancel():
+            self._forget(item)
+            return
         if self._stop.is_set():
             self._fail(item, Unavailable("the service is shutting down"))
             return

@@ -14,9 +14,12 @@ from fastapi.testclient import TestClient
 from PIL import Image
 
 from service.api import WEB_DIR, create_app, mount_web
+from service.errors import PUBLIC_ERRORS
+from service.metrics import REJECT_REASONS
+from service.params import RenderFields, field_range
 from service.presets import all_presets
 from service.renderer import Renderer
-from service.settings import Settings, get_settings
+from service.settings import MAX_PIXELS, Settings, get_settings
 from service.shaders import ShaderError
 
 pytestmark = pytest.mark.gl
@@ -107,6 +110,12 @@ def test_metrics_exposition(client):
     assert sample(client, "opaline_cache_hits_total") >= 1
     assert sample(client, "opaline_cache_misses_total") >= 1
     assert sample(client, "opaline_rejected_requests_total", {"reason": "invalid"}) >= 1
+
+
+def test_every_rejection_reason_is_exposed_from_the_start():
+    """Each reason the error handlers count is on /metrics at 0 before the first rejection."""
+    counted = {reason for _, reason in PUBLIC_ERRORS.values() if reason} | {"too_large"}
+    assert counted == set(REJECT_REASONS)
 
 
 # Images
@@ -320,6 +329,11 @@ def test_size_over_service_limit_is_422(backend):
         assert client.get("/v1/mdf?size=200").status_code == 422
 
 
+def test_service_limits_are_within_the_parameter_ranges():
+    """MAX_PIXELS and the "[16 … limit]" of a limit message are the size fields' own range."""
+    assert field_range(RenderFields, "width") == f"[16 … {MAX_PIXELS}]"
+
+
 def test_body_over_limit_is_413(backend):
     """A body over max_body_bytes answers 413, by Content-Length or counted while streaming."""
     with make_client(backend, max_body_bytes=1024) as client:
@@ -446,3 +460,15 @@ def test_openapi_documents_every_parameter_and_media_type(client):
         assert {"image/png", "application/x-npy"} <= set(content)
     assert "Retry-After" in spec["paths"]["/v1/render"]["get"]["responses"]["503"]["headers"]
     assert client.get("/docs").status_code == 200
+
+
+def test_openapi_documents_readiness_etag_and_mdf_bounds(client):
+    """/readyz's body is described for 200 and 503; images document their ETag; mdf its bounds."""
+    spec = client.get("/openapi.json").json()
+    ready = spec["paths"]["/readyz"]["get"]["responses"]
+    for status in ("200", "503"):
+        assert ready[status]["content"]["application/json"]["schema"]["$ref"].endswith("Readiness")
+    for path, method in (("/v1/render", "get"), ("/v1/render", "post"), ("/v1/mdf", "get")):
+        assert "ETag" in spec["paths"][path][method]["responses"]["200"]["headers"]
+    mdf = {p["name"]: p["schema"] for p in spec["paths"]["/v1/mdf"]["get"]["parameters"]}
+    assert mdf["wavelengths"]["minimum"] == 0 and mdf["wavelengths"]["maximum"] == 128

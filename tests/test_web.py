@@ -222,3 +222,17 @@ def test_busy_service_is_shown_and_retried(page):
     settle(page)
     assert len(refused) == 1 and page.locator("#err-general").is_hidden()
     assert shown_bytes(page) != good
+
+
+def test_invalid_value_during_a_render_stops_the_spinner(page):
+    """A value made invalid while a render is in flight ends the loading state with the wait."""
+    open_page(page, "?preset=cd-rom")
+    held: list = []
+    page.route("**/v1/render?*", lambda route: held.append(route))  # held: never answered
+    page.fill("#in-mu_f", "7")
+    page.wait_for_function("document.body.classList.contains('loading')")
+    page.fill("#in-mu_f", "")
+    settle(page)
+    assert held and "valid value" in page.text_content("#status")
+    assert not page.evaluate("document.body.classList.contains('loading')")
+    page.unroute("**/v1/render?*")  # the held request was aborted by the page itself

@@ -193,6 +193,36 @@ def test_failed_context_is_retried_and_reported(make_pool):
     assert pool.ready
 
 
+def test_cancelled_job_is_skipped_and_the_worker_keeps_serving(make_pool):
+    """A queued job whose future was cancelled is not rendered, and its worker lives on."""
+    pool = make_pool(workers=1)
+    gate = Gate()
+    pool.submit("busy", gate)
+    assert gate.entered.wait(WAIT)
+    ran: list = []
+    assert pool.submit("cancelled", returning(b"x", ran)).cancel()
+    gate.opened.set()
+    assert pool.submit("next", returning(b"ok")).result(WAIT) == b"ok"
+    assert ran == []
+
+
+def test_context_that_cannot_describe_itself_fails_the_worker_at_once(make_pool):
+    """A context lost before it is described: the worker is failed and releases it, no hang."""
+
+    class Lost:
+        def describe(self) -> dict[str, str]:
+            raise RuntimeError("context lost")
+
+    class Mute(FakeRenderer):
+        gl = Lost()
+
+    started = time.monotonic()
+    pool = make_pool(workers=1, factory=Mute)
+    assert time.monotonic() - started < WAIT / 2
+    assert pool.status()[0]["state"] == "failed" and "context lost" in pool.status()[0]["error"]
+    assert FakeRenderer.made[0].released_on == FakeRenderer.made[0].thread
+
+
 def test_stop_fails_queued_jobs_and_releases_on_worker_threads(make_pool):
     """Stopping fails queued jobs with Unavailable; each context is released on its thread."""
     pool = make_pool(workers=2, queue_size=4)

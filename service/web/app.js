@@ -88,14 +88,17 @@
   async function getJSON(url) {
     const resp = await fetch(url);
     const body = await resp.json().catch(() => null);
-    if (!resp.ok) throw Object.assign(new Error(problemText(body, resp)), { status: resp.status });
+    if (!resp.ok) {
+      throw Object.assign(new Error(problemLines(body, resp).join('\n')), { status: resp.status });
+    }
     return body;
   }
 
-  function problemText(body, resp) {
+  // An error answer's lines: a 422 gives one per problem, other errors one.
+  function problemLines(body, resp) {
     const detail = body && body.detail;
-    if (Array.isArray(detail)) return detail.join('\n');
-    return detail ? String(detail) : `${resp.status} ${resp.statusText}`;
+    if (Array.isArray(detail)) return detail.map(String);
+    return [detail ? String(detail) : `${resp.status} ${resp.statusText}`];
   }
 
   // ------------------------------------------------------- schema → specs
@@ -460,10 +463,9 @@
     }
     if (!resp.ok) {
       const body = await resp.json().catch(() => null);
-      const detail = body && body.detail;
       return {
         ok: false, status: resp.status, retryAfter: Number(resp.headers.get('Retry-After')) || 1,
-        lines: Array.isArray(detail) ? detail.map(String) : [problemText(body, resp)],
+        lines: problemLines(body, resp),
       };
     }
     const blob = await resp.blob().catch(() => null);
@@ -494,6 +496,8 @@
     inflight = new AbortController();
     if (!state.info) return;
     if (state.invalid.size) {
+      // The fetch just aborted, if any, no longer ends its own loading state.
+      document.body.classList.remove('loading');
       clearErrors();
       for (const [name, message] of state.invalid) showError(name, [message]);
       setStatus('Waiting for a valid value…');
