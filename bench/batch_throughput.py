@@ -15,9 +15,9 @@ logic nor the server's image cache can help. Figures:
 
 Configurations: --jobs 1 (one GL thread); --jobs 2 (two spawned processes,
 LP_NUM_THREADS = cores / 2 each, the default); --jobs 2 with LP_NUM_THREADS
-left to llvmpipe (every core each); and, when ``service/serve.py`` exists,
-``--server`` against ``opaline serve`` on 127.0.0.1 (a free port, nothing
-else contacted) with --jobs 2 and 4. The server is stopped whatever happens.
+left to llvmpipe (every core each); and, unless ``--no-server``, ``--server``
+against ``opaline serve`` on 127.0.0.1 (a free port, nothing else
+contacted) with --jobs 2 and 4. The server is stopped whatever happens.
 """
 
 from __future__ import annotations
@@ -152,8 +152,8 @@ def main() -> None:
                         ["--jobs", "2"], {}, args, 100))
     rows.append(measure(f"local --jobs 2 (LP_NUM_THREADS={cores} each)", ["--jobs", "2"],
                         {"LP_NUM_THREADS": str(cores)}, args, 200))
-    if args.no_server or not (ROOT / "service" / "serve.py").is_file():
-        result["server_note"] = "`--server`: not measured (service/serve.py absent or skipped)."
+    if args.no_server:
+        result["server_note"] = "`--server`: not measured (--no-server)."
         print(result["server_note"])
     else:
         with LocalServer(workers=1) as server:

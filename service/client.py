@@ -53,6 +53,8 @@ class RemoteRenderer:
     def __init__(self, url: str, *, jobs: int = 4, timeout: float = 120.0, retries: int = 5,
                  backoff: float = 0.5, max_delay: float = 10.0,
                  client: httpx.Client | None = None) -> None:
+        if retries < 0:
+            raise ValueError(f"retries={retries} must be 0 or more")
         self.url = url.rstrip("/") + "/v1/render"
         self.retries = retries
         self.backoff = backoff

@@ -32,6 +32,8 @@ from .params import RenderRequest, describe_errors
 SUFFIXES = (".toml", ".json")
 MANIFEST_SUFFIXES = (".manifest.toml", ".manifest.json")
 SCHEMA_KEY = "$schema"  # allowed in files so editors can find the schema; ignored
+# An output name: every segment starts with a letter or digit, so no "..", no hidden
+# file and no absolute path can escape the output folder.
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*(/[A-Za-z0-9][A-Za-z0-9._-]*)*$")
 MANIFEST_KEYS = {"defaults", "material"}
 ENTRY_KEYS = {"name", "path"}
@@ -61,11 +63,11 @@ def read_table(path: Path) -> dict[str, Any]:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise MaterialError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    is_json = path.suffix.lower() == ".json"
     try:
-        data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
+        data = json.loads(text) if is_json else tomllib.loads(text)
     except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        kind = "JSON" if path.suffix.lower() == ".json" else "TOML"
-        raise MaterialError(f"{path}: invalid {kind}: {exc}") from None
+        raise MaterialError(f"{path}: invalid {'JSON' if is_json else 'TOML'}: {exc}") from None
     if not isinstance(data, dict):
         raise MaterialError(f"{path}: expected a table of fields, got {type(data).__name__}")
     data.pop(SCHEMA_KEY, None)
@@ -102,10 +104,8 @@ def manifest_items(path: Path, prefix: str, overrides: dict[str, Any]) -> list[I
         entries, defaults = _manifest_parts(path, data)
     except MaterialError as exc:
         return [Item(prefix + path.name.split(".")[0], str(path), error=str(exc))]
-    items = []
-    for index, entry in enumerate(entries):
-        items.append(_entry_item(path, index, entry, defaults, prefix, overrides))
-    return items
+    return [_entry_item(path, index, entry, defaults, prefix, overrides)
+            for index, entry in enumerate(entries)]
 
 
 def _manifest_parts(path: Path, data: dict) -> tuple[list, dict]:
@@ -132,7 +132,7 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict, prefix: 
     name = entry.get("name")
     if name is None and isinstance(ref, str):
         name = Path(ref).with_suffix("").as_posix()
-    if not isinstance(name, str) or not NAME_RE.match(name) or ".." in name.split("/"):
+    if not isinstance(name, str) or not NAME_RE.match(name):
         shown = f"#{index + 1}" if name is None else str(name)
         return Item(prefix + shown, where, error=f"{where}: name={name!r} must be letters, digits, "
                     "'.', '_', '-' and '/' separators (a relative output name)")
@@ -182,24 +182,25 @@ def collect(inputs: list[str | Path], overrides: dict[str, Any] | None = None,
         path = Path(raw)
         if path.is_dir():
             for found in scan_folder(path, exclude):
-                rel = found.relative_to(path)
-                items.extend(_file_items(found, rel.parent.as_posix(), rel, overrides))
+                items.extend(_file_items(found, found.relative_to(path), overrides))
         elif path.is_file():
-            items.extend(_file_items(path, ".", Path(path.name), overrides))
+            items.extend(_file_items(path, Path(path.name), overrides))
         else:
             items.append(Item(path.stem or str(path), str(path),
                               error=f"{path}: no such file or folder"))
     return _unique(items)
 
 
-def _file_items(path: Path, rel_dir: str, rel: Path, overrides: dict[str, Any]) -> list[Item]:
+def _file_items(path: Path, rel: Path, overrides: dict[str, Any]) -> list[Item]:
+    """The items of one file; ``rel`` is its path below the input folder (or its bare name)."""
+    name = rel.with_suffix("").as_posix()
     if path.suffix.lower() not in SUFFIXES:
-        return [Item(rel.with_suffix("").as_posix(), str(path),
+        return [Item(name, str(path),
                      error=f"{path}: expected a .toml or .json material file or manifest")]
     if is_manifest(path):
-        prefix = "" if rel_dir == "." else rel_dir + "/"
+        prefix = "" if rel.parent == Path(".") else rel.parent.as_posix() + "/"
         return manifest_items(path, prefix, overrides)
-    return material_items(path, rel.with_suffix("").as_posix(), overrides)
+    return material_items(path, name, overrides)
 
 
 def _unique(items: list[Item]) -> list[Item]:

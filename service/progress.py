@@ -13,7 +13,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from .batch import Task
+    from .batch_plan import Task
 
 
 def use_rich(stream: Any, env: Any = os.environ) -> bool:
@@ -107,6 +107,6 @@ def _bar(console: Any) -> Any:
                     TimeRemainingColumn(), console=console)
 
 
-def make_progress(stream: Any = None) -> PlainProgress:
-    stream = stream or sys.stderr
-    return RichProgress(stream) if use_rich(stream) else PlainProgress(sys.stdout)
+def make_progress() -> PlainProgress:
+    """The bar on stderr when it is a terminal (outside CI), else plain lines on stdout."""
+    return RichProgress(sys.stderr) if use_rich(sys.stderr) else PlainProgress(sys.stdout)

@@ -7,17 +7,20 @@ each named underneath, with the failures as red cells.
 
 from __future__ import annotations
 
+import io
+import math
+from html import escape
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+from urllib.parse import quote
 
 from .cli import write_atomic
 
 if TYPE_CHECKING:
-    from .batch import Task
+    from .batch_plan import Task
 
 THUMB = 128
 LABEL = 18
-WRITTEN = ("rendered", "skipped")  # the statuses with an output on disk
 
 
 def write_contact_sheet(out: Path, tasks: list[Task]) -> None:
@@ -48,14 +51,11 @@ def thumbnail(path: Path) -> Any:
     return image.resize(size, Image.Resampling.LANCZOS)
 
 
-def write_sheet(out: Path, tasks: list[Task]) -> Path:
+def write_sheet(out: Path, tasks: list[Task]) -> None:
     """A grid of every thumbnail with its name drawn under it; failures as red cells."""
-    import io
-    import math
-
     from PIL import Image, ImageDraw, ImageFont
 
-    shown = [t for t in tasks if t.status in (*WRITTEN, "failed")]
+    shown = [t for t in tasks if t.written or t.status == "failed"]
     columns = max(1, min(8, math.ceil(math.sqrt(len(shown) or 1))))
     rows = max(1, math.ceil(len(shown) / columns))
     cell_w, cell_h = THUMB + 8, THUMB + LABEL + 8
@@ -68,17 +68,16 @@ def write_sheet(out: Path, tasks: list[Task]) -> Path:
     data = io.BytesIO()
     sheet.save(data, format="PNG")
     write_atomic(out / "sheet.png", data.getvalue())
-    return out / "sheet.png"
 
 
 def _draw_cell(sheet: Any, draw: Any, font: Any, task: Task, x: int, y: int) -> None:
     """One task's thumbnail (or red 'failed' square) at (x, y), its name under it."""
-    if task.status == "failed" or task.output is None:
-        draw.rectangle((x, y, x + THUMB - 1, y + THUMB - 1), fill=(110, 20, 20))
-        draw.text((x + 6, y + 6), "failed", fill=(255, 220, 220), font=font)
-    else:
+    if task.written and task.output is not None:
         thumb = thumbnail(task.output)
         sheet.paste(thumb, (x + (THUMB - thumb.width) // 2, y + (THUMB - thumb.height) // 2))
+    else:
+        draw.rectangle((x, y, x + THUMB - 1, y + THUMB - 1), fill=(110, 20, 20))
+        draw.text((x + 6, y + 6), "failed", fill=(255, 220, 220), font=font)
     draw.text((x, y + THUMB + 3), _fit(draw, task.item.name, font), fill=(230, 230, 230),
               font=font)
 
@@ -93,29 +92,23 @@ def _fit(draw: Any, text: str, font: Any) -> str:
 
 # DIR/index.html
 
-def write_index(out: Path, tasks: list[Task]) -> Path:
+def write_index(out: Path, tasks: list[Task]) -> None:
     """An HTML page of the thumbnails with their names, and the failures with their reasons."""
-    from html import escape
-
     figures, failures = [], []
     for task in tasks:
         name = escape(task.item.name)
-        if task.status == "failed" or task.output is None:
-            failures.append(f"<li><b>{name}</b>: {escape(task.error or task.status)}</li>")
-        elif task.status in WRITTEN:
+        if task.written and task.output is not None:
             figures.append(_figure(out, task.output, name))
+        elif task.status == "failed":
+            failures.append(f"<li><b>{name}</b>: {escape(task.error or task.status)}</li>")
     failed = (f"<h2>Failed ({len(failures)})</h2><ul>{''.join(failures)}</ul>"
               if failures else "")
     page = INDEX_TEMPLATE.format(count=len(figures), figures="\n".join(figures), failed=failed)
     write_atomic(out / "index.html", page.encode())
-    return out / "index.html"
 
 
 def _figure(out: Path, output: Path, name: str) -> str:
     """A PNG as an image, anything else (.npy) as a link, captioned with the escaped ``name``."""
-    from html import escape
-    from urllib.parse import quote
-
     href = quote(output.relative_to(out).as_posix())
     body = (f'<img src="{href}" alt="{name}" loading="lazy">' if output.suffix == ".png"
             else f'<a href="{href}">{escape(output.name)}</a>')

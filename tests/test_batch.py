@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service import batch
+from service import batch, progress
 from service.cli import main
+from service.sheet import THUMB
 
 pytestmark = pytest.mark.gl
 ROOT = Path(__file__).resolve().parent.parent
@@ -195,7 +196,7 @@ def test_sheet_writes_an_index_and_a_grid_image(mixed, backend):
         assert sheet.format == "PNG"
         grid = np.asarray(sheet.convert("RGB"))
     columns = 3  # ceil(sqrt(6))
-    assert grid.shape[1] == columns * (batch.THUMB + 8) and grid.shape[0] >= 2 * batch.THUMB
+    assert grid.shape[1] == columns * (THUMB + 8) and grid.shape[0] >= 2 * THUMB
     assert grid.std() > 10, "the sheet holds pictures, not one colour"
 
 
@@ -228,9 +229,9 @@ def test_plain_progress_in_ci_and_off_a_terminal():
         def isatty(self) -> bool:
             return True
 
-    assert batch.use_rich(Tty(), {}) is True
-    assert batch.use_rich(Tty(), {"CI": "true"}) is False
-    assert batch.use_rich(io.StringIO(), {}) is False
+    assert progress.use_rich(Tty(), {}) is True
+    assert progress.use_rich(Tty(), {"CI": "true"}) is False
+    assert progress.use_rich(io.StringIO(), {}) is False
 
 
 def test_rich_progress_reports_failures_and_finishes(tmp_path, backend):
@@ -239,7 +240,7 @@ def test_rich_progress_reports_failures_and_finishes(tmp_path, backend):
                                           "bad-range.toml": MIXED["bad-range.toml"]})
     stream = io.StringIO()
     options = batch.Options(out=tmp_path / "out", backend=backend)
-    summary = batch.run_batch([folder], options, progress=batch.RichProgress(stream))
+    summary = batch.run_batch([folder], options, progress=progress.RichProgress(stream))
     assert summary["counts"] == {"rendered": 1, "skipped": 0, "failed": 1}
     text = stream.getvalue()
     assert "failed  bad-range" in text and "rendering" in text and "1/1" in text
@@ -317,15 +318,6 @@ def test_interrupt_leaves_no_partial_file_and_a_rerun_finishes(tmp_path, backend
         assert len(assert_no_partial_files(out)) == total
 
 
-def test_worker_processes_are_spawned_not_forked(tmp_path):
-    """--jobs N > 1 uses the spawn start method (a context made before a fork hangs, DESIGN §8)."""
-    workers = batch.Workers(batch.Options(out=tmp_path, jobs=2))
-    try:
-        assert workers.executor._mp_context.get_start_method() == "spawn"
-    finally:
-        workers.close()
-
-
 def interrupt_rename(monkeypatch, suffix: str) -> None:
     """Make the first rename onto a name ending in ``suffix`` look like a Ctrl-C arriving then."""
     real = os.replace
@@ -346,7 +338,7 @@ def test_interrupt_during_a_write_leaves_neither_image_nor_temp_file(tmp_path, b
     options = batch.Options(out=tmp_path / "out", backend=backend)
     interrupt_rename(monkeypatch, "disc-a.png")
     with pytest.raises(KeyboardInterrupt):
-        batch.run_batch([folder], options, progress=batch.PlainProgress(io.StringIO()))
+        batch.run_batch([folder], options, progress=progress.PlainProgress(io.StringIO()))
     assert sorted(p.name for p in options.out.iterdir()) == ["summary.json"]
     summary = summary_of(options.out)
     assert summary["interrupted"] and by_name(summary)["disc-a"]["status"] == "interrupted"
@@ -356,7 +348,7 @@ def test_sidecar_is_written_after_the_image(tmp_path, backend, monkeypatch):
     """Cut between a changed image and its sidecar, the next run still re-renders the image."""
     folder = make_folder(tmp_path / "m", {"disc-a.toml": MIXED["disc-a.toml"]})
     options = batch.Options(out=tmp_path / "out", backend=backend)
-    quiet = batch.PlainProgress(io.StringIO())
+    quiet = progress.PlainProgress(io.StringIO())
     batch.run_batch([folder], options, progress=quiet)
     old = (options.out / "disc-a.png").read_bytes()
     (folder / "disc-a.toml").write_text('preset = "cd-rom"\nmu_f = 12\n' + SMALL)
@@ -374,6 +366,7 @@ def test_sidecar_is_written_after_the_image(tmp_path, backend, monkeypatch):
     (["--size", "big"], "expected WxH"),
     (["--server", "localhost:8000"], "expected an http:// or https:// URL"),
     (["--jobs", "0"], "--jobs=0 is out of range"),
+    (["--retries", "-1"], "--retries=-1 is out of range: allowed [0 … 100]"),
 ])
 def test_bad_options_are_usage_errors(tmp_path, capsys, option, message):
     """A bad command-line option fails once, with status 2, before anything renders."""

@@ -277,3 +277,9 @@ def test_remote_images_equal_local_ones(tmp_path, backend):
         assert remote == local
         with Image.open(io.BytesIO(remote)) as image:
             assert np.asarray(image).std() > 1
+
+
+def test_negative_retries_are_refused():
+    """retries counts the attempts after the first: below zero is an error, not zero attempts."""
+    with pytest.raises(ValueError, match="retries=-1"):
+        RemoteRenderer("http://127.0.0.1:1", retries=-1)

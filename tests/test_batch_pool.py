@@ -1,0 +1,53 @@
+"""The batch's worker pools: spawned processes with a context each, ended at once on abort."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from service.batch_plan import Task
+from service.batch_pool import GLProcesses, HttpThreads, start_pool
+from service.materials import Item
+from service.params import RenderRequest
+from service.presets import get_preset
+from service.request import resolve
+
+
+def test_worker_processes_are_spawned_not_forked():
+    """--jobs N > 1 uses the spawn start method (a context made before a fork hangs, DESIGN §8)."""
+    pool = start_pool(jobs=2)
+    try:
+        assert pool.executor._mp_context.get_start_method() == "spawn"
+    finally:
+        pool.close()
+
+
+def test_a_server_gets_http_threads_whatever_the_job_count():
+    """With a server URL the pool sends requests; it makes no process and no GL context."""
+    for jobs in (1, 3):
+        pool = start_pool(jobs, server="http://127.0.0.1:1")
+        try:
+            assert isinstance(pool, HttpThreads) and pool.executor._max_workers == jobs
+        finally:
+            pool.close()
+
+
+@pytest.mark.gl
+def test_abort_ends_worker_processes_mid_render(backend):
+    """abort() terminates the processes, the one busy with a long render included."""
+    request = RenderRequest(preset="cd-rom", width=2048, height=2048, samples=256)
+    task = Task(Item("heavy", "heavy", request), job=resolve(request, get_preset("cd-rom")))
+    pool = GLProcesses(2, backend)
+    future = pool.submit(task)
+    deadline = time.monotonic() + 60
+    while not pool.executor._processes:
+        assert time.monotonic() < deadline, "no worker process started"
+        time.sleep(0.05)
+    processes = list(pool.executor._processes.values())
+    time.sleep(2)  # past start-up: the render is under way
+    assert not future.done(), "the render should still be running"
+    pool.abort()
+    for process in processes:
+        process.join(timeout=10)
+    assert not any(p.is_alive() for p in processes), "a worker outlived abort()"
