@@ -19,7 +19,9 @@ out vec3 v_normal;
 out vec3 v_tangent;
 out vec2 v_uv;
 
-// The depth pre-pass and the shading pass must produce identical depths.
+// Every variant compiles this code with other defines, and the all-features
+// baseline is compared with the scene's own variant pixel for pixel: all of them
+// must rasterise exactly the same coverage.
 invariant gl_Position;
 
 void main() {

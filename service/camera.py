@@ -31,9 +31,14 @@ def model_matrix(rotation_deg: tuple[float, float, float]) -> np.ndarray:
     return np.asarray(rotation)
 
 
+def _centre(light: Light, target) -> np.ndarray | float:
+    """What a light's position is taken around: the target for a point light; a directional
+    light's "position" is already a direction, so the origin."""
+    return np.asarray(target, dtype=np.float64) if light.type == "point" else 0.0
+
+
 def _key_offset(light: Light, target) -> np.ndarray:
-    centre = np.asarray(target, dtype=np.float64) if light.type == "point" else 0.0
-    return np.asarray(light.position, dtype=np.float64) - centre
+    return np.asarray(light.position, dtype=np.float64) - _centre(light, target)
 
 
 def key_light_direction(lights: list[Light], target) -> dict[str, float] | None:
@@ -64,6 +69,6 @@ def place_key_light(
     az = math.radians(current["azimuth"] if azimuth_deg is None else azimuth_deg)
     el = math.radians(current["elevation"] if elevation_deg is None else elevation_deg)
     direction = np.array([math.cos(el) * math.cos(az), math.sin(el), math.cos(el) * math.sin(az)])
-    position = direction * radius + (np.asarray(target) if key.type == "point" else 0.0)
+    position = direction * radius + _centre(key, target)
     moved = key.model_copy(update={"position": tuple(float(x) for x in position)})
     return [moved, *lights[1:]]

@@ -8,10 +8,19 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+from typing import get_args
 
 from pydantic import ValidationError
 
-from .params import Material, RenderFields, RenderRequest, describe_errors, field_range
+from .params import (
+    ImageFormat,
+    Material,
+    Quality,
+    RenderFields,
+    RenderRequest,
+    describe_errors,
+    field_range,
+)
 from .presets import PresetError, UnknownPreset, all_presets
 from .request import CostError, resolve
 
@@ -171,11 +180,12 @@ def make_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     fmt = argparse.RawDescriptionHelpFormatter
+    parameters = parameter_help()
 
     render = sub.add_parser(
         "render",
         help="render a preset to an image file",
-        epilog=parameter_help(),
+        epilog=parameters,
         formatter_class=fmt,
     )
     render.add_argument("preset", help="preset name (see `opaline presets`)")
@@ -190,12 +200,10 @@ def make_parser() -> argparse.ArgumentParser:
         "--size", metavar="WxH", help="image size, each 16 … 2048 (default 256x256)"
     )
     render.add_argument(
-        "--format", choices=["png", "png16", "npy"], help="output format (default png)"
+        "--format", choices=get_args(ImageFormat), help="output format (default png)"
     )
     render.add_argument(
-        "--quality",
-        choices=["draft", "standard", "high", "reference"],
-        help="quality tier (default standard)",
+        "--quality", choices=get_args(Quality), help="quality tier (default standard)"
     )
     render.add_argument("--transparent", action="store_true", help="transparent PNG background")
     render.add_argument("-o", "--output", required=True, help="output file")
@@ -205,7 +213,7 @@ def make_parser() -> argparse.ArgumentParser:
     mdf = sub.add_parser(
         "mdf",
         help="plot the MDF over the half-vector disc (Figs. 2, 3, 6, 7)",
-        epilog=parameter_help(),
+        epilog=parameters,
         formatter_class=fmt,
     )
     mdf.add_argument(

@@ -12,13 +12,11 @@ import ctypes.util
 import os
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Literal
 
 import moderngl
 
 from .osmesa import OSMesaLoader, OSMesaUnavailable
 
-Backend = Literal["egl", "osmesa", "auto"]
 BACKENDS: tuple[str, ...] = ("egl", "osmesa", "auto")
 GL_REQUIRE = 330
 
@@ -135,6 +133,20 @@ def create_osmesa() -> GLContext:
         loader = OSMesaLoader()
     except OSMesaUnavailable as exc:
         raise ContextError(f"OSMesa backend unavailable: {exc}") from exc
+    try:
+        ctx = _loader_context(loader)
+        if ctx.version_code < GL_REQUIRE:
+            raise ContextError(f"OSMesa gave GL {ctx.version_code}, Opaline needs {GL_REQUIRE}")
+        return _wrap(ctx, "osmesa", loader)
+    except BaseException:
+        # The loader made its context current: unbind it before destroying it (as release does).
+        loader.__exit__()
+        loader.release()
+        raise
+
+
+def _loader_context(loader: OSMesaLoader) -> moderngl.Context:
+    """What moderngl.create_context does, with a custom loader in place of a glcontext backend."""
     from moderngl import mgl  # the C extension takes a custom loader object
 
     ctx = moderngl.Context.__new__(moderngl.Context)
@@ -147,10 +159,7 @@ def create_osmesa() -> GLContext:
     ctx._screen = ctx.detect_framebuffer(0)
     ctx.fbo = ctx.detect_framebuffer()
     ctx.mglo.fbo = ctx.fbo.mglo
-    if ctx.version_code < GL_REQUIRE:
-        loader.release()
-        raise ContextError(f"OSMesa gave GL {ctx.version_code}, Opaline needs {GL_REQUIRE}")
-    return _wrap(ctx, "osmesa", loader)
+    return ctx
 
 
 def create_context(backend: str | None = None) -> GLContext:

@@ -7,6 +7,8 @@ always gives the same bytes.
 from __future__ import annotations
 
 import io
+import struct
+import zlib
 
 import numpy as np
 from PIL import Image
@@ -31,9 +33,6 @@ def png8(display: np.ndarray, alpha: bool) -> bytes:
 
 def png16(display: np.ndarray, alpha: bool) -> bytes:
     """16 bits per channel. Pillow cannot write 16-bit RGB, so the PNG is built with zlib."""
-    import struct
-    import zlib
-
     channels = 4 if alpha else 3
     data = quantise(display[..., :channels], 16).astype(">u2")
     height, width = data.shape[:2]
@@ -77,3 +76,8 @@ def mdf_display(plot: np.ndarray) -> np.ndarray:
     peak = float(plot.max())
     scaled = plot / peak if peak > 0 else plot
     return srgb_encode(scaled).astype(np.float32)
+
+
+def encode_mdf(plot: np.ndarray, fmt: str) -> bytes:
+    """An MDF plot as ``npy`` (linear D) or, for any other format, a normalised 8-bit PNG."""
+    return npy(plot) if fmt == "npy" else png8(mdf_display(plot), alpha=False)

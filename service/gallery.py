@@ -5,8 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import get_args
 
-from .params import Material, RenderRequest
+from .cli import add_common, write_atomic
+from .params import Material, Quality, RenderRequest
 
 # The paper's MDF figures. Figs. 2, 6, 7 are single-channel (no rotation);
 # Figs. 3 and 8 rotate G and B.
@@ -56,7 +58,6 @@ def build_gallery(
     backend: str | None = None,
     quality: str = "standard",
 ) -> dict[str, list[str]]:
-    from .cli import write_atomic
     from .pipeline import LocalRenderer
     from .presets import all_presets
 
@@ -92,8 +93,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--size", type=int, default=256, help="preset image size (default 256)")
     parser.add_argument("--mdf-size", type=int, default=256, help="MDF plot size (default 256)")
-    parser.add_argument(
-        "--quality", default="standard", choices=["draft", "standard", "high", "reference"]
-    )
-    parser.add_argument("--backend", choices=["egl", "osmesa", "auto"], default=None)
+    parser.add_argument("--quality", default="standard", choices=get_args(Quality))
+    add_common(parser)
     parser.set_defaults(func=cmd_gallery)

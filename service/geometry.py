@@ -130,10 +130,6 @@ def _grid_indices(rows: int, cols: int) -> np.ndarray:
 # -- argument checks ---------------------------------------------------------
 
 
-
-
-
-
 def _positive(name: str, value) -> float:
     value = generators.real(name, value)
     if value <= 0.0:

@@ -35,10 +35,6 @@ SEED = (0, 2**63 - 1)
 _BUMP_PEAK = 3.0 * math.sqrt(3.0) / 8.0
 
 
-
-
-
-
 def _from_gradient(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
     """Unit normals of a height field given dh/dx (x right) and dh/dy (y down, image rows).
 

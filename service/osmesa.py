@@ -84,14 +84,17 @@ class OSMesaLoader:
         # All rendering goes to framebuffer objects; the window-system buffer only
         # has to exist for MakeCurrent, so a single pixel is enough.
         self._buffer = (ctypes.c_ubyte * 4)()
-        if not lib.OSMesaMakeCurrent(self._ctx, self._buffer, GL_UNSIGNED_BYTE, 1, 1):
+        if not self._make_current():
             lib.OSMesaDestroyContext(self._ctx)
             raise OSMesaUnavailable("OSMesaMakeCurrent failed")
+
+    def _make_current(self) -> bool:
+        return bool(self._lib.OSMesaMakeCurrent(self._ctx, self._buffer, GL_UNSIGNED_BYTE, 1, 1))
 
     def __enter__(self) -> OSMesaLoader:
         """Make this context current (moderngl's Context.__enter__ calls this)."""
         if self._ctx:
-            self._lib.OSMesaMakeCurrent(self._ctx, self._buffer, GL_UNSIGNED_BYTE, 1, 1)
+            self._make_current()
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -191,11 +191,6 @@ def _fmt(value: float | None) -> str:
     return f"{value:g}"
 
 
-def field_doc(model: type[BaseModel], name: str) -> str:
-    info = model.model_fields[name]
-    return info.description or ""
-
-
 RANGE_ERRORS = {"less_than_equal", "greater_than_equal", "less_than", "greater_than"}
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .encode import encode_frame, mdf_display, npy, png8
+from .encode import encode_frame, encode_mdf
 from .params import Material, RenderRequest
 from .presets import get_preset
 from .renderer import Renderer
@@ -68,5 +68,4 @@ class LocalRenderer:
     def mdf_bytes(
         self, material: Material, size: int, fmt: str = "png", wavelengths: int = 0
     ) -> bytes:
-        plot = self.mdf_plot(material, size, wavelengths)
-        return npy(plot) if fmt == "npy" else png8(mdf_display(plot), alpha=False)
+        return encode_mdf(self.mdf_plot(material, size, wavelengths), fmt)

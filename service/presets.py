@@ -17,7 +17,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from .params import RenderFields, describe_errors
+from .params import STRICT, RenderFields, Unit, describe_errors
 
 Vec3 = tuple[float, float, float]
 NonNegative3 = tuple[
@@ -25,12 +25,7 @@ NonNegative3 = tuple[
     Annotated[float, Field(ge=0.0)],
     Annotated[float, Field(ge=0.0)],
 ]
-Colour = tuple[
-    Annotated[float, Field(ge=0.0, le=1.0)],
-    Annotated[float, Field(ge=0.0, le=1.0)],
-    Annotated[float, Field(ge=0.0, le=1.0)],
-]
-STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+Colour = tuple[Unit, Unit, Unit]
 
 
 class PresetError(ValueError):

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .spectrum import rgb_weights, rotation_at, sample_wavelengths
+
 EPS_DENOM = 1e-4  # DESIGN §1: every denominator clamped to at least this
 EPS_HALF = 1e-6  # |l + v| below this: no half vector, no specular
 TWO_PI = 2.0 * np.pi
@@ -75,8 +77,6 @@ def mdf_rgb(material, hx, hy, hz, wavelengths=0):
     """D for R, G, B: the MDF at half vectors rotated by 0, θ1, θ2 (eq. 2), or,
     with ``wavelengths`` > 0, per wavelength and integrated to linear sRGB."""
     if wavelengths > 0:
-        from .spectrum import rgb_weights, rotation_at, sample_wavelengths
-
         thetas = rotation_at(sample_wavelengths(wavelengths), material.theta1, material.theta2)
         weights = rgb_weights(wavelengths)
         total = 0.0
@@ -115,8 +115,14 @@ def shading_frame(n, t):
 
 
 def specular_rgb(material, n, t, l, v, wavelengths=0):
-    """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel; zero where h is undefined."""
-    t, b, n = shading_frame(n, t)
+    """``specular`` in the shading frame of ``n`` and ``t``."""
+    return specular(material, shading_frame(n, t), l, v, wavelengths)
+
+
+def specular(material, frame, l, v, wavelengths=0):
+    """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel in a (t, b, n) frame; zero where h is
+    undefined."""
+    t, b, n = frame
     sum_lv = l + v
     length = np.linalg.norm(sum_lv, axis=-1, keepdims=True)
     h = sum_lv / np.maximum(length, 1e-30)
@@ -135,10 +141,10 @@ def specular_rgb(material, n, t, l, v, wavelengths=0):
 
 def reflected_radiance(material, n, t, l, v, wavelengths=0):
     """f·max(n·l, 0) for a light of unit irradiance, per channel (linear RGB)."""
-    t_, b_, n_ = shading_frame(n, t)
-    nl = np.sum(n_ * l, axis=-1)
+    frame = shading_frame(n, t)
+    nl = np.sum(frame[2] * l, axis=-1)
     diffuse = material.kd * np.asarray(material.albedo, dtype=np.float64) / np.pi
-    f = diffuse + specular_rgb(material, n, t, l, v, wavelengths)
+    f = diffuse + specular(material, frame, l, v, wavelengths)
     return f * np.maximum(nl, 0.0)[..., None]
 
 

@@ -154,9 +154,12 @@ class Renderer:
         targets = self.targets(size)
         offsets = sample_offsets(job.samples)
         self._draw_samples(job, preset, targets, offsets, all_features)
-        source = targets.sample_tex if len(offsets) == 1 else targets.accum_tex
+        # One sample is left in the sample target; more are summed in the accumulation target.
+        if len(offsets) == 1:
+            fbo, source = targets.sample_fbo, targets.sample_tex
+        else:
+            fbo, source = targets.accum_fbo, targets.accum_tex
         if job.format == "npy":
-            fbo = targets.sample_fbo if len(offsets) == 1 else targets.accum_fbo
             linear = self.read(fbo, size) / np.float32(len(offsets))
             return Frame(linear=linear, display=None)
         self._resolve(job, preset, source, targets, len(offsets))
@@ -208,11 +211,14 @@ class Renderer:
         )
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
+            # Bound once: the accumulate pass between samples binds unit 0 only.
+            normal_map.use(location=NORMAL_MAP_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
-        accumulate = self.programs.get("accumulate.glsl")
         multi = len(offsets) > 1
         if multi:
+            accumulate = self.programs.get("accumulate.glsl")
+            accumulate["u_sample"].value = 0
             targets.accum_fbo.use()
             targets.accum_fbo.clear(0.0, 0.0, 0.0, 0.0)
         for dx, dy in offsets:
@@ -221,9 +227,6 @@ class Renderer:
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
             program["u_jitter"].value = (2.0 * dx / width, 2.0 * dy / height)
-            if normal_map is not None:
-                # Rebound every sample: the accumulate pass below uses unit 0.
-                normal_map.use(location=NORMAL_MAP_UNIT)
             vao.render(moderngl.TRIANGLES)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
@@ -231,7 +234,6 @@ class Renderer:
                 ctx.blend_func = moderngl.ONE, moderngl.ONE
                 targets.accum_fbo.use()
                 targets.sample_tex.use(location=0)
-                accumulate["u_sample"].value = 0
                 self.fullscreen(accumulate)
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
 
@@ -264,10 +266,7 @@ class Renderer:
     ) -> np.ndarray:
         """The MDF over the projected half-vector disc, (size, size, 3) linear float32."""
         self.gl.make_current()
-        defines = uniforms.material_defines(material, wavelengths, aa)
-        defines = {
-            k: defines[k] for k in ("MDF_MULTIPEAK", "MDF_ASHIKHMIN", "WAVELENGTHS", "AA_ANALYTIC")
-        }
+        defines = uniforms.mdf_defines(material, wavelengths, aa)
         defines["PRECISE_PHASE"] = self.gl.has_fp64
         program = self.programs.get("mdf_plot.glsl", defines)
         targets = self.targets((size, size))
@@ -292,30 +291,33 @@ class Renderer:
         count = len(n)
         width = min(count, 256)
         height = -(-count // width)
+        # aa stays "none" (AA_ANALYTIC false, so not compiled in): a probe has no pixel footprint.
         defines = uniforms.material_defines(material, wavelengths)
-        defines.pop("AA_ANALYTIC")
         defines["PRECISE_PHASE"] = self.gl.has_fp64
         program = self.programs.get("brdf_probe.glsl", defines)
         textures = []
-        for unit, (name, data) in enumerate(
-            (("u_normal", n), ("u_tangent", t), ("u_light", l), ("u_view", v))
-        ):
-            grid = np.zeros((height * width, 4), dtype="f4")
-            grid[:count, :3] = data
-            tex = self.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            tex.use(location=unit)
-            program[name].value = unit
-            textures.append(tex)
-        uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
-        targets = self.targets((width, height))
-        targets.display_fbo.use()
-        self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-        self.fullscreen(program)
-        out = self.read(targets.display_fbo, (width, height))[::-1].reshape(-1, 4)[:count, :3]
-        for tex in textures:
-            tex.release()
-        return out
+        try:
+            for unit, (name, data) in enumerate(
+                (("u_normal", n), ("u_tangent", t), ("u_light", l), ("u_view", v))
+            ):
+                grid = np.zeros((height * width, 4), dtype="f4")
+                grid[:count, :3] = data
+                tex = self.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
+                textures.append(tex)
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                tex.use(location=unit)
+                program[name].value = unit
+            uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
+            targets = self.targets((width, height))
+            targets.display_fbo.use()
+            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+            self.fullscreen(program)
+            image = self.read(targets.display_fbo, (width, height))
+        finally:
+            for tex in textures:
+                tex.release()
+        # Case i sits at GL row i // width; read() gave image order (top row first).
+        return image[::-1].reshape(-1, 4)[:count, :3]
 
     def release(self) -> None:
         self.gl.make_current()

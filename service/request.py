@@ -70,7 +70,9 @@ class Job:
         data["material"] = self.material.model_dump(mode="json")
         return data
 
-    def cache_key(self, scene_key: str = "") -> str:
+    def cache_key(self, scene_key: str) -> str:
+        """``scene_key`` is ``Preset.scene_key()``: a job names its preset, not the scene it
+        draws, so an edited preset file must give new keys."""
         from .shaders import sources_digest
 
         payload = json.dumps(

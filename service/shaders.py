@@ -23,7 +23,6 @@ log = logging.getLogger(__name__)
 
 INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 DECLARED = re.compile(r"^//!\s*defines:(.*)$")
-STAGES = ("VERTEX_SHADER", "FRAGMENT_SHADER")
 
 Defines = Mapping[str, int | bool]
 

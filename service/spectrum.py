@@ -44,4 +44,6 @@ def rgb_weights(count: int) -> np.ndarray:
     xyz = np.array([cmfs[w] for w in lam])  # (count, 3), interpolated by colour-science
     to_rgb = colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB
     rgb = xyz @ to_rgb.T
-    return rgb / rgb.sum(axis=0, keepdims=True)
+    weights = rgb / rgb.sum(axis=0, keepdims=True)
+    weights.setflags(write=False)  # cached and shared: a caller must not change it in place
+    return weights

@@ -11,16 +11,25 @@ from .params import Material
 from .spectrum import rgb_weights, rotation_at, sample_wavelengths
 
 
-def material_defines(
+def mdf_defines(
     material: Material, wavelengths: int = 0, aa: str = "none"
 ) -> dict[str, int | bool]:
-    """Only the features this material uses (DESIGN §2, "model only what a scene requires")."""
+    """The MDF's features alone: what the MDF plot compiles (it has no reflectance)."""
     multipeak = material.mdf == "multipeak"
     return {
         "MDF_MULTIPEAK": multipeak,
         "MDF_ASHIKHMIN": not multipeak,
         "WAVELENGTHS": wavelengths if wavelengths > 0 else False,
         "AA_ANALYTIC": multipeak and aa == "analytic",
+    }
+
+
+def material_defines(
+    material: Material, wavelengths: int = 0, aa: str = "none"
+) -> dict[str, int | bool]:
+    """Only the features this material uses (DESIGN §2, "model only what a scene requires")."""
+    return {
+        **mdf_defines(material, wavelengths, aa),
         "DIFFUSE": material.kd > 0.0 and max(material.albedo) > 0.0,
         "FRESNEL": material.f0 < 1.0,
     }

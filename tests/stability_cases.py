@@ -116,7 +116,6 @@ def _extremes() -> dict[str, Material]:
 EXTREMES: dict[str, Material] = _extremes()
 
 
-
 # -- shading cases --------------------------------------------------------------
 
 def as_f32(a) -> np.ndarray:

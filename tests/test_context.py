@@ -264,3 +264,24 @@ def test_second_renderer_on_a_thread_leaves_the_first_intact(name):
     result = run("-c", TWO_RENDERERS, name)
     assert result.returncode == 0, result.stderr[-2000:]
     assert "max diff: 0.0" in result.stdout
+
+
+def test_failed_osmesa_context_is_unbound_and_destroyed(monkeypatch):
+    """If moderngl cannot wrap the new OSMesa context, that context is unbound, then destroyed."""
+    calls = []
+
+    class Loader:
+        def __exit__(self, *exc):
+            calls.append("unbind")
+
+        def release(self):
+            calls.append("destroy")
+
+    def broken(loader):
+        raise RuntimeError("no GL functions")
+
+    monkeypatch.setattr(context, "OSMesaLoader", Loader)
+    monkeypatch.setattr(context, "_loader_context", broken)
+    with pytest.raises(RuntimeError, match="no GL functions"):
+        context.create_osmesa()
+    assert calls == ["unbind", "destroy"]

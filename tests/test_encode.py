@@ -167,3 +167,12 @@ def test_mdf_display_of_zero_plot_is_black():
     """An all-zero plot stays zero (no division by zero)."""
     shown = encode.mdf_display(np.zeros((16, 16, 3)))
     assert np.all(shown == 0.0)
+
+
+def test_encode_mdf_is_linear_npy_or_normalised_png():
+    """encode_mdf keeps linear D in npy and writes the normalised display plot as an RGB PNG."""
+    plot = np.random.default_rng(8).random((16, 16, 3)).astype(np.float32) * 40.0
+    assert np.array_equal(np.load(io.BytesIO(encode.encode_mdf(plot, "npy"))), plot)
+    png = encode.encode_mdf(plot, "png")
+    assert png == encode.png8(encode.mdf_display(plot), alpha=False)
+    assert Image.open(io.BytesIO(png)).mode == "RGB"

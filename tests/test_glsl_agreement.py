@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from stability_cases import random_cases
 
 from service import reference as ref
 from service.params import Material
@@ -82,19 +83,9 @@ def test_mdf_plot_layout_is_the_paper_convention(renderer):
     assert upper_left > 1.5 * upper_right
 
 
-def random_unit(rng, count):
-    v = rng.normal(size=(count, 3))
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
 def shading_cases(rng, count):
     """Random frames with l and v in the upper hemisphere of n, plus degenerate cases."""
-    n = random_unit(rng, count)
-    t = random_unit(rng, count)
-    l = random_unit(rng, count)
-    v = random_unit(rng, count)
-    l *= np.sign(np.sum(l * n, axis=1, keepdims=True))
-    v *= np.sign(np.sum(v * n, axis=1, keepdims=True))
+    n, t, l, v = random_cases(rng, count)
     # Degenerate geometry (DESIGN §6): l = -v, h exactly along n, t parallel to n, grazing.
     n[:4] = [0.0, 0.0, 1.0]
     t[:4] = [[1, 0, 0], [0, 0, 1], [1, 0, 0], [1, 0, 0]]

@@ -1,4 +1,4 @@
-// Display encoding: exposure, tone map, sRGB transfer (IEC 61966-2-1).
+// Display encoding after exposure (resolve.glsl): tone map, sRGB transfer (IEC 61966-2-1).
 #ifndef DISPLAY_GLSL
 #define DISPLAY_GLSL
 
