@@ -110,6 +110,9 @@ def shading_frame(n, t):
     fallback_axis = np.where(np.abs(n[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     fallback = np.cross(n, fallback_axis)
     t = np.where(length > 1e-6, t / np.maximum(length, 1e-30), normalize(fallback))
+    # A short remainder (t nearly along n) is mostly cancellation error: a second
+    # projection makes it perpendicular to working precision ("twice is enough").
+    t = normalize(t - n * np.sum(n * t, axis=-1, keepdims=True))
     b = np.cross(n, t)
     return t, b, n
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from service import reference as ref
@@ -255,6 +255,9 @@ def assert_orthonormal_right_handed(t, b, n):
 
 @PROPERTY
 @given(unit_vectors(), unit_vectors())
+# Found by hypothesis: a tangent 2e-6 off the normal left a remainder of mostly
+# cancellation error before the frame's second projection.
+@example(np.array([1.0, 2e-6, 0.0]) / np.linalg.norm([1.0, 2e-6, 0.0]), np.array([1.0, 0.0, 0.0]))
 def test_shading_frame_orthonormal_right_handed(n, t):
     """(t, b, n) is orthonormal with t × b = n, for any tangent."""
     frame = ref.shading_frame(*as_batch(n, t))

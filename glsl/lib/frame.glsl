@@ -22,6 +22,9 @@ realmat3 shading_frame(real3 n, real3 t) {
         real3 axis = abs(n.x) < 0.9 ? real3(1.0, 0.0, 0.0) : real3(0.0, 1.0, 0.0);
         t = safe_normalize(cross(n, axis));
     }
+    // A short remainder (t nearly along n) is mostly cancellation error: a second
+    // projection makes it perpendicular to working precision ("twice is enough").
+    t = safe_normalize(t - n * dot(n, t));
     return realmat3(t, cross(n, t), n);
 }
 
