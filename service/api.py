@@ -35,7 +35,7 @@ from .params import MATERIAL_FIELDS, Material, RenderRequest
 from .presets import Preset, all_presets, get_preset
 from .queries import MdfQuery, RenderQuery
 from .renderer import Renderer
-from .request import TIERS, CostError, Job, check_cost, resolve
+from .request import TIERS, Job, check_cost, check_plot_cost, resolve
 from .settings import Settings, SettingsDep, get_settings
 from .spectrum import rgb_weights
 from .worker import Task, WorkerPool, image_task, mdf_task
@@ -114,10 +114,7 @@ def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     size = min(settings.max_width, settings.max_height)
     if params.size > size:
         raise LimitError([_over_limit("size", params.size, size)])
-    cost = params.size * params.size * max(params.wavelengths, 3)
-    if cost > settings.cost_budget:
-        raise CostError(f"cost={cost} (size²×max(wavelengths, 3)) is over the budget of "
-                        f"{settings.cost_budget}: lower the size or wavelengths")
+    check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
 
 
 async def answer_image(svc: Service, request: Request, key: str, task: Task, label: str,

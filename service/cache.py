@@ -10,12 +10,11 @@ into it while the event loop reads from it.
 from __future__ import annotations
 
 import hashlib
-import json
 import threading
 from collections import OrderedDict
 
-from . import __version__
 from .params import Material
+from .request import content_key
 
 
 class ImageCache:
@@ -57,14 +56,8 @@ class ImageCache:
 
 def mdf_key(material: Material, size: int, fmt: str, wavelengths: int) -> str:
     """Cache key of an MDF plot, hashed like ``Job.cache_key``."""
-    from .shaders import sources_digest
-
-    payload = json.dumps(
-        {"mdf_plot": material.model_dump(mode="json"), "size": size, "format": fmt,
-         "wavelengths": wavelengths, "shaders": sources_digest(), "version": __version__},
-        sort_keys=True,
-    )
-    return hashlib.sha256(payload.encode()).hexdigest()[:32]
+    return content_key({"mdf_plot": material.model_dump(mode="json"), "size": size,
+                        "format": fmt, "wavelengths": wavelengths})
 
 
 def etag(key: str, renderer: str = "") -> str:

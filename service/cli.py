@@ -12,6 +12,7 @@ from typing import get_args
 
 from pydantic import ValidationError
 
+from .context import BACKENDS
 from .params import (
     ImageFormat,
     Material,
@@ -167,7 +168,7 @@ def cmd_info(args: argparse.Namespace) -> None:
 def add_common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--backend",
-        choices=["egl", "osmesa", "auto"],
+        choices=BACKENDS,
         default=None,
         help="headless GL backend (default: $OPALINE_GL_BACKEND or egl)",
     )

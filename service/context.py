@@ -12,12 +12,14 @@ import ctypes.util
 import os
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Literal, get_args
 
 import moderngl
 
 from .osmesa import OSMesaLoader, OSMesaUnavailable
 
-BACKENDS: tuple[str, ...] = ("egl", "osmesa", "auto")
+BackendName = Literal["egl", "osmesa", "auto"]
+BACKENDS: tuple[str, ...] = get_args(BackendName)
 GL_REQUIRE = 330
 
 EGL_EXTENSIONS = 0x3055

@@ -83,12 +83,7 @@ def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> l
         else:
             rest.append({**err, "loc": () if loc and isinstance(loc[0], int) else loc})
 
-    class _Errors:  # the one method describe_errors reads from a ValidationError
-        @staticmethod
-        def errors() -> list[dict[str, Any]]:
-            return rest
-
-    return lines + describe_errors(_Errors(), model)  # type: ignore[arg-type]
+    return lines + describe_errors(rest, model)
 
 
 def _problem(status: int, detail: str | list[str], headers: dict[str, str] | None = None):

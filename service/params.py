@@ -230,10 +230,14 @@ def _owner(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel], str]:
     return owner, name
 
 
-def describe_errors(exc: ValidationError, model: type[BaseModel] = RenderRequest) -> list[str]:
-    """One line per problem: the field, the value given, and what is allowed."""
+def describe_errors(
+    exc: ValidationError | list[dict[str, Any]], model: type[BaseModel] = RenderRequest
+) -> list[str]:
+    """One line per problem: the field, the value given, and what is allowed.
+
+    Takes a ValidationError or its ``errors()`` list (FastAPI hands over the list)."""
     lines = []
-    for err in exc.errors():
+    for err in exc.errors() if isinstance(exc, ValidationError) else exc:
         loc = [str(p) for p in err["loc"] if not isinstance(p, int) or len(err["loc"]) > 1]
         owner, name = _owner(model, tuple(err["loc"]))
         where = ".".join(loc) or name

@@ -73,18 +73,16 @@ class Job:
     def cache_key(self, scene_key: str) -> str:
         """``scene_key`` is ``Preset.scene_key()``: a job names its preset, not the scene it
         draws, so an edited preset file must give new keys."""
-        from .shaders import sources_digest
+        return content_key({"job": self.canonical(), "scene": scene_key})
 
-        payload = json.dumps(
-            {
-                "job": self.canonical(),
-                "scene": scene_key,
-                "shaders": sources_digest(),
-                "version": __version__,
-            },
-            sort_keys=True,
-        )
-        return hashlib.sha256(payload.encode()).hexdigest()[:32]
+
+def content_key(payload: dict) -> str:
+    """Hash of what an image depends on, with the shader sources and the version, so a
+    changed shader or release never answers from an old image."""
+    from .shaders import sources_digest
+
+    stamped = {**payload, "shaders": sources_digest(), "version": __version__}
+    return hashlib.sha256(json.dumps(stamped, sort_keys=True).encode()).hexdigest()[:32]
 
 
 def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None) -> Job:
@@ -108,9 +106,21 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
 
 
 def check_cost(job: Job, budget: int) -> None:
-    if job.cost > budget:
+    factors = f"{job.width}×{job.height}×{job.samples}×{max(job.wavelengths, 3)}"
+    _within_budget(job.cost, "width×height×samples×max(wavelengths, 3)", factors, budget,
+                   "the size, samples or wavelengths")
+
+
+def check_plot_cost(size: int, wavelengths: int, budget: int) -> None:
+    """The MDF plot's cost: one sample per pixel of a size×size plot."""
+    cost = size * size * max(wavelengths, 3)
+    _within_budget(cost, "size²×max(wavelengths, 3)", f"{size}²×{max(wavelengths, 3)}", budget,
+                   "the size or wavelengths")
+
+
+def _within_budget(cost: int, formula: str, factors: str, budget: int, advice: str) -> None:
+    if cost > budget:
         raise CostError(
-            f"cost={job.cost} (width×height×samples×max(wavelengths, 3) = "
-            f"{job.width}×{job.height}×{job.samples}×{max(job.wavelengths, 3)}) is over the "
-            f"budget of {budget}: lower the size, samples or wavelengths"
+            f"cost={cost} ({formula} = {factors}) is over the budget of {budget}: "
+            f"lower {advice}"
         )

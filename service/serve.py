@@ -41,8 +41,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument("--workers", type=int,
                        help="render worker threads, one GL context each (default 1)")
     serve.add_argument("--queue-size", type=int, help="jobs that may wait before 503 (default 32)")
-    serve.add_argument("--backend", choices=["egl", "osmesa", "auto"],
-                       help="headless GL backend (default $OPALINE_GL_BACKEND or egl)")
+    from .cli import add_common  # imported here: cli imports this module while building
+
+    add_common(serve)
     serve.add_argument("--log-level", default="info",
                        choices=["critical", "error", "warning", "info", "debug"])
     serve.set_defaults(func=cmd_serve)

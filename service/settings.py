@@ -9,12 +9,13 @@ dependency, so tests override the dependency instead of patching globals.
 from __future__ import annotations
 
 from functools import lru_cache
-from typing import Annotated, Literal
+from typing import Annotated
 
 from fastapi import Depends
 from pydantic import Field, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from .context import BackendName
 from .pipeline import DEFAULT_COST_BUDGET
 
 MAX_PIXELS = 2048  # params.Pixels' upper bound: settings may lower it, never raise it
@@ -25,7 +26,7 @@ class Settings(BaseSettings):
 
     model_config = SettingsConfigDict(env_prefix="OPALINE_", extra="ignore", frozen=True)
 
-    gl_backend: Literal["egl", "osmesa", "auto"] = Field(
+    gl_backend: BackendName = Field(
         "egl", description="Headless GL backend of the render workers.")
     host: str = Field("127.0.0.1", description="Address `opaline serve` binds.")
     port: int = Field(8000, ge=1, le=65535, description="Port `opaline serve` binds.")

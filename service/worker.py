@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .cache import ImageCache
-from .encode import encode_frame, mdf_display, npy, png8
+from .encode import encode_frame, encode_mdf
 from .metrics import Metrics
 from .params import Material
 from .presets import Preset
@@ -77,8 +77,7 @@ def mdf_task(material: Material, size: int, fmt: str, wavelengths: int) -> Task:
     """Plot the MDF (as ``LocalRenderer.mdf_bytes``): normalised sRGB PNG or linear npy."""
 
     def run(renderer: Any) -> bytes:
-        plot = renderer.mdf_plot(material, size, wavelengths)
-        return npy(plot) if fmt == "npy" else png8(mdf_display(plot), alpha=False)
+        return encode_mdf(renderer.mdf_plot(material, size, wavelengths), fmt)
 
     return run
 
