@@ -5,6 +5,17 @@
 #
 # Settings come from OPALINE_* variables (service/settings.py), e.g.
 #   docker run -e OPALINE_QUEUE_SIZE=64 -e OPALINE_GL_BACKEND=osmesa ...
+
+# Stage 1: build the wheel (shaders and presets ship inside it as package data).
+FROM python:3.11-slim-bookworm AS build
+WORKDIR /src
+COPY pyproject.toml README.md ./
+COPY service ./service
+COPY glsl ./glsl
+COPY presets ./presets
+RUN pip wheel --no-cache-dir --no-deps -w /wheels .
+
+# Stage 2: the service, without the sources or build tools.
 FROM python:3.11-slim-bookworm
 
 # Debian 12's Mesa 22.3: EGL (libegl1 is the glvnd loader, libegl-mesa0 Mesa's vendor
@@ -23,15 +34,8 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
     OPALINE_GL_BACKEND=egl \
     OPALINE_PORT=8000
 
-# A regular (non-editable) install: the shaders and presets ship as package data
-# (service/_glsl, service/_presets in pyproject.toml), so the source tree is not needed after.
-WORKDIR /tmp/opaline-src
-COPY pyproject.toml README.md ./
-COPY service ./service
-COPY glsl ./glsl
-COPY presets ./presets
-RUN pip install . \
-    && cd / && rm -rf /tmp/opaline-src
+COPY --from=build /wheels /wheels
+RUN pip install /wheels/*.whl && rm -rf /wheels
 
 # Non-root; a home gives Mesa somewhere to keep its shader cache.
 RUN useradd --create-home --uid 10001 --shell /usr/sbin/nologin opaline

@@ -85,6 +85,13 @@ class GLProcesses(Pool):
         super().abort()
         for process in processes:
             process.terminate()
+        # Wait for them here, bounded, so abort() returns with no worker left running;
+        # one stuck in a driver call that ignores SIGTERM gets SIGKILL.
+        for process in processes:
+            process.join(timeout=5)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=5)
 
 
 class HttpThreads(Pool):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import pytest
 
@@ -48,6 +49,20 @@ def test_abort_ends_worker_processes_mid_render(backend):
     time.sleep(2)  # past start-up: the render is under way
     assert not future.done(), "the render should still be running"
     pool.abort()
-    for process in processes:
-        process.join(timeout=10)
-    assert not any(p.is_alive() for p in processes), "a worker outlived abort()"
+    deadline = time.monotonic() + 10
+    while any(running(p.pid) for p in processes) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not any(running(p.pid) for p in processes), "a worker outlived abort()"
+
+
+def running(pid: int) -> bool:
+    """Whether the kernel still runs ``pid`` (a zombie has ended).
+
+    Asked of /proc rather than Process.is_alive(): the executor's own thread also
+    reaps its workers, and is_alive() reads "alive" when the other thread reaped first.
+    """
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except FileNotFoundError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] not in ("Z", "X")
