@@ -10,8 +10,16 @@ from __future__ import annotations
 import os
 
 import pytest
+from hypothesis import settings
 
 from service.context import requested_backend
+
+# CI replays the same examples every run (a red CI must mean a change broke
+# something); local runs keep exploring new ones, and pin what they find with
+# @example.
+settings.register_profile("ci", derandomize=True, database=None)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 
 def pytest_configure(config: pytest.Config) -> None:
