@@ -38,8 +38,7 @@ sys.path[:0] = [str(ROOT / "bench"), str(ROOT)]
 from accuracy_plot import plot  # noqa: E402
 from accuracy_report import TIER_ORDER, kept_guide, to_csv, to_markdown  # noqa: E402
 from metrics import all_metrics  # noqa: E402
-
-from service.cli import write_atomic  # noqa: E402
+from opaline.cli.main import write_atomic  # noqa: E402
 
 DOCS = ROOT / "docs"
 # The all-features program is timed on these; "1 spp" (aa none) checks that it keeps the job's AA.
@@ -63,7 +62,7 @@ class Setting:
 
 def settings(quick: bool) -> list[Setting]:
     """The tiers, then the explicit sweeps; a setting listed twice is rendered once."""
-    from service.request import TIERS
+    from opaline.model.request import TIERS
 
     wanted = [Setting(t, int(TIERS[t]["samples"]), int(TIERS[t]["wavelengths"]),
                       str(TIERS[t]["aa"]), ["tier"]) for t in TIER_ORDER]
@@ -97,14 +96,14 @@ class Bench:
     """One renderer, one size; renders settings of a preset, warm and timed."""
 
     def __init__(self, size: int) -> None:
-        from service.renderer import Renderer
+        from opaline.gl.renderer import Renderer
 
         self.size = size
         self.renderer = Renderer(None)
 
     def job(self, preset, setting: Setting, size: int | None = None):
-        from service.params import RenderRequest
-        from service.request import resolve
+        from opaline.model.params import RenderRequest
+        from opaline.model.request import resolve
 
         size = size or self.size
         request = RenderRequest(preset=preset.name, width=size, height=size,
@@ -218,7 +217,7 @@ def main() -> None:
     parser.add_argument("--images", type=Path, help="also write a strip of the tiers per preset")
     args = parser.parse_args()
 
-    from service.presets import all_presets
+    from opaline.model.presets import all_presets
 
     presets = all_presets()
     names = args.presets or list(presets)

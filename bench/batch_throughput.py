@@ -33,7 +33,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from service.localserver import LocalServer
+from opaline.server.localserver import LocalServer
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
@@ -53,7 +53,7 @@ def write_materials(folder: Path, count: int, quality: str, salt: int) -> None:
 
 
 def run_batch(folder: Path, out: Path, extra: list[str], env: dict[str, str]) -> dict:
-    command = [sys.executable, "-m", "service.cli", "batch", str(folder), "--out", str(out),
+    command = [sys.executable, "-m", "opaline.cli.main", "batch", str(folder), "--out", str(out),
                *extra]
     start = time.perf_counter()
     done = subprocess.run(command, cwd=ROOT, env=env, capture_output=True, text=True,
@@ -95,7 +95,7 @@ def measure(name: str, extra: list[str], env_extra: dict[str, str], args: argpar
 
 
 def gl_renderer() -> str:
-    done = subprocess.run([sys.executable, "-m", "service.cli", "info"], cwd=ROOT,
+    done = subprocess.run([sys.executable, "-m", "opaline.cli.main", "info"], cwd=ROOT,
                           capture_output=True, text=True, timeout=120)
     found = dict(line.split(": ", 1) for line in done.stdout.splitlines() if ": " in line)
     return f"{found.get('backend', '?')}: {found.get('renderer', '?')}"

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import httpx
 
-from service.localserver import LocalServer
+from opaline.server.localserver import LocalServer
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"

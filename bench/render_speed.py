@@ -23,11 +23,11 @@ SIZES = (256, 1024)
 
 def measure(backend: str, repeats: int) -> dict:
     """Run inside a child process: median seconds per stage for every preset and size."""
-    from service.encode import encode_frame
-    from service.params import RenderRequest
-    from service.presets import all_presets, get_preset
-    from service.renderer import Renderer
-    from service.request import resolve
+    from opaline.gl.renderer import Renderer
+    from opaline.model.params import RenderRequest
+    from opaline.model.presets import all_presets, get_preset
+    from opaline.model.request import resolve
+    from opaline.output.encode import encode_frame
 
     renderer = Renderer(backend)
     rows = []

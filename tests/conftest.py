@@ -12,7 +12,7 @@ import os
 import pytest
 from hypothesis import settings
 
-from service.context import requested_backend
+from opaline.gl.context import requested_backend
 
 # CI replays the same examples every run (a red CI must mean a change broke
 # something); local runs keep exploring new ones, and pin what they find with
@@ -33,7 +33,7 @@ def backend() -> str:
 
 @pytest.fixture(scope="session")
 def renderer(backend):
-    from service.renderer import Renderer
+    from opaline.gl.renderer import Renderer
 
     r = Renderer(backend)
     yield r
@@ -43,7 +43,7 @@ def renderer(backend):
 @pytest.fixture(scope="session")
 def local(renderer):
     """A LocalRenderer sharing the session's context."""
-    from service.pipeline import LocalRenderer
+    from opaline.local.pipeline import LocalRenderer
 
     local = LocalRenderer.__new__(LocalRenderer)
     local.renderer = renderer

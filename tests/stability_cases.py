@@ -19,8 +19,8 @@ import warnings
 
 import numpy as np
 
-from service import reference as ref
-from service.params import Material
+from opaline.model import reference as ref
+from opaline.model.params import Material
 
 PI = math.pi
 TWO_PI = 2.0 * math.pi

@@ -13,14 +13,14 @@ from fastapi import FastAPI
 from fastapi.testclient import TestClient
 from PIL import Image
 
-from service.api import WEB_DIR, create_app, mount_web
-from service.errors import PUBLIC_ERRORS
-from service.metrics import REJECT_REASONS
-from service.params import RenderFields, field_range
-from service.presets import all_presets
-from service.renderer import Renderer
-from service.settings import MAX_PIXELS, Settings, get_settings
-from service.shaders import ShaderError
+from opaline.gl.renderer import Renderer
+from opaline.gl.shaders import ShaderError
+from opaline.model.params import RenderFields, field_range
+from opaline.model.presets import all_presets
+from opaline.server.api import WEB_DIR, create_app, mount_web
+from opaline.server.errors import PUBLIC_ERRORS
+from opaline.server.metrics import REJECT_REASONS
+from opaline.settings import MAX_PIXELS, Settings, get_settings
 
 pytestmark = pytest.mark.gl
 

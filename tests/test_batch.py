@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service import batch, progress
-from service.cli import main
-from service.sheet import THUMB
+from opaline.batch import progress
+from opaline.batch import run as batch
+from opaline.batch.sheet import THUMB
+from opaline.cli.main import main
 
 pytestmark = pytest.mark.gl
 ROOT = Path(__file__).resolve().parent.parent
@@ -264,7 +265,7 @@ HEAVY = 'preset = "cd-rom"\nmu_f = {mu}\nwidth = 384\nheight = 384\nsamples = 16
 def start_batch(folder: Path, out: Path, jobs: int, backend: str) -> subprocess.Popen:
     env = {**os.environ, "CI": "true"}
     return subprocess.Popen(
-        [sys.executable, "-m", "service.cli", "batch", str(folder), "--out", str(out),
+        [sys.executable, "-m", "opaline.cli.main", "batch", str(folder), "--out", str(out),
          "--jobs", str(jobs), "--backend", backend],
         cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 

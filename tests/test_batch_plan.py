@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from service.batch_plan import Task, plan, remove_temporaries, up_to_date, write_result
-from service.materials import Item
-from service.params import RenderRequest
+from opaline.batch.plan import Task, plan, remove_temporaries, up_to_date, write_result
+from opaline.model.materials import Item
+from opaline.model.params import RenderRequest
 
 
 def planned(tmp_path, name: str = "disc", **fields) -> Task:

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from service.batch_plan import Task
-from service.batch_pool import GLProcesses, HttpThreads, start_pool
-from service.materials import Item
-from service.params import RenderRequest
-from service.presets import get_preset
-from service.request import resolve
+from opaline.batch.plan import Task
+from opaline.batch.pool import GLProcesses, HttpThreads, start_pool
+from opaline.model.materials import Item
+from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import resolve
 
 
 def test_worker_processes_are_spawned_not_forked():

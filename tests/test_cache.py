@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import threading
 
-from service.cache import ImageCache, etag, matches, mdf_key
-from service.params import Material
+from opaline.model.params import Material
+from opaline.server.cache import ImageCache, etag, matches, mdf_key
 
 
 def test_get_returns_what_was_put():

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.camera import key_light_direction, place_key_light
-from service.presets import Light
+from opaline.gl.camera import key_light_direction, place_key_light
+from opaline.model.presets import Light
 
 TARGET = (0.5, -0.25, 1.0)
 

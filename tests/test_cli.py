@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service import cli, reference
-from service.params import Material, RenderRequest
-from service.shaders import ShaderError
+from opaline.cli import main as cli
+from opaline.gl.shaders import ShaderError
+from opaline.model import reference
+from opaline.model.params import Material, RenderRequest
+from opaline.output import files
 
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere")
@@ -39,7 +41,7 @@ def shared_renderer(renderer, monkeypatch):
     A second context made and released on this thread would leave the session's OSMesa
     context broken for every later GL test (see test_context's two-renderer test).
     """
-    from service import pipeline
+    from opaline.local import pipeline
 
     class Shared(pipeline.LocalRenderer):
         def __init__(self, backend=None, cost_budget=pipeline.DEFAULT_COST_BUDGET):
@@ -249,14 +251,14 @@ def failing_render(monkeypatch):
     def boom(self, request):
         raise ShaderError("surface.glsl {} failed to compile: test")
 
-    monkeypatch.setattr("service.pipeline.LocalRenderer.render_bytes", boom)
+    monkeypatch.setattr("opaline.local.pipeline.LocalRenderer.render_bytes", boom)
 
 
 def failing_replace(monkeypatch):
     def boom(src, dst):
         raise OSError("disk full")
 
-    monkeypatch.setattr(cli.os, "replace", boom)
+    monkeypatch.setattr(files.os, "replace", boom)
 
 
 @pytest.mark.gl
@@ -303,7 +305,7 @@ def test_written_file_respects_umask(tmp_path):
     """Files written by the CLI get the usual 0666 & ~umask mode, like open() would give."""
     umask = os.umask(0o022)
     try:
-        cli.write_atomic(tmp_path / "a.png", b"data")
+        files.write_atomic(tmp_path / "a.png", b"data")
         reference_file = tmp_path / "b.png"
         reference_file.write_bytes(b"data")
     finally:

@@ -17,10 +17,10 @@ import pytest
 from PIL import Image
 from pydantic import ValidationError
 
-from service.cli import main
-from service.client import RemoteError, RemoteRenderer
-from service.params import RenderRequest, describe_errors
-from service.presets import UnknownPreset, get_preset
+from opaline.batch.client import RemoteError, RemoteRenderer
+from opaline.cli.main import main
+from opaline.model.params import RenderRequest, describe_errors
+from opaline.model.presets import UnknownPreset, get_preset
 
 SMALL = {"width": 64, "height": 64, "quality": "draft"}
 
@@ -255,7 +255,7 @@ def test_batch_reports_server_errors_per_item(tmp_path):
 @pytest.mark.gl
 def test_remote_images_equal_local_ones(tmp_path, backend):
     """A server that really renders (LocalRenderer) gives the same bytes as a local batch."""
-    from service import api_python
+    from opaline.local import api as api_python
 
     folder = tmp_path / "m"
     write_materials(folder, 3)

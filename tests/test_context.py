@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service import context, osmesa
-from service.context import ContextError, create_context, pick_egl_device, requested_backend
+from opaline.gl import context, osmesa
+from opaline.gl.context import ContextError, create_context, pick_egl_device, requested_backend
 
 ROOT = Path(__file__).resolve().parent.parent
 SOFTWARE = "EGL_MESA_device_software"
@@ -42,7 +42,7 @@ def run_python(code: str) -> subprocess.CompletedProcess:
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return run("-m", "service.cli", *args)
+    return run("-m", "opaline.cli.main", *args)
 
 
 # Choosing a backend
@@ -158,7 +158,7 @@ def test_auto_reports_every_failure(no_osmesa, monkeypatch):
 def test_auto_uses_egl_when_osmesa_is_missing():
     """create_context('auto') still succeeds, through EGL, on a system without libOSMesa."""
     code = HIDE_OSMESA + textwrap.dedent("""
-        from service.context import create_context, create_osmesa, ContextError
+        from opaline.gl.context import create_context, create_osmesa, ContextError
         try:
             create_osmesa()
         except ContextError as exc:
@@ -178,7 +178,7 @@ def test_auto_uses_egl_when_osmesa_is_missing():
 def test_auto_falls_back_to_osmesa_when_egl_fails():
     """create_context('auto') falls back to OSMesa when EGL cannot make a context."""
     code = textwrap.dedent("""
-        from service import context
+        from opaline.gl import context
         def broken():
             raise context.ContextError("EGL context could not be created: test")
         context.create_egl = broken
@@ -229,7 +229,7 @@ def test_info_reports_backend_and_renderer(backend):
 def test_context_describes_itself(backend):
     """A context in this process reports its backend, renderer and a GL >= 3.3 core version."""
     result = run_python(textwrap.dedent(f"""
-        from service.context import create_context
+        from opaline.gl.context import create_context
         gl = create_context({backend!r})
         print(sorted(gl.describe()), gl.backend, gl.ctx.version_code)
         gl.release()
@@ -243,8 +243,8 @@ def test_context_describes_itself(backend):
 TWO_RENDERERS = textwrap.dedent("""
     import sys
     import numpy as np
-    from service.params import RenderRequest
-    from service.pipeline import LocalRenderer
+    from opaline.model.params import RenderRequest
+    from opaline.local.pipeline import LocalRenderer
     request = RenderRequest(preset="cd-rom", width=32, height=32, quality="draft", mu_f=3.0)
     first = LocalRenderer(sys.argv[1])
     before = first.render_array(request)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service import encode
+from opaline.output import encode
 
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from service import geometry
-from service.geometry import Mesh
+from opaline.scene import geometry
+from opaline.scene.geometry import Mesh
 
 UNIT_TOL = 1e-5
 ORTHO_TOL = 1e-5

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 import pytest
-from stability_cases import random_cases
 
-from service import reference as ref
-from service.params import Material
+from opaline.model import reference as ref
+from opaline.model.params import Material
+from stability_cases import random_cases
 
 pytestmark = pytest.mark.gl
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from service import materials
-from service.cli import main
-from service.materials import MaterialError, collect, load_material, material_schema
+from opaline.cli.main import main
+from opaline.model import materials
+from opaline.model.materials import MaterialError, collect, load_material, material_schema
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from service import normalmaps
+from opaline.scene import normalmaps
 
 GENERATORS = {"bumps": normalmaps.bumps, "nacre": normalmaps.nacre}
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from service.params import Material, RenderRequest, describe_errors
+from opaline.model.params import Material, RenderRequest, describe_errors
 
 TAU = 2 * math.pi
 # DESIGN §3 (plus exposure and the light angles), written out independently.

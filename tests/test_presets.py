@@ -7,9 +7,9 @@ import shutil
 
 import pytest
 
-from service import presets as presets_module
-from service.params import RenderRequest
-from service.presets import (
+from opaline.model import presets as presets_module
+from opaline.model.params import RenderRequest
+from opaline.model.presets import (
     PresetError,
     UnknownPreset,
     all_presets,
@@ -17,7 +17,7 @@ from service.presets import (
     load_preset_file,
     presets_dir,
 )
-from service.request import resolve
+from opaline.model.request import resolve
 
 # DESIGN.md §4, written out independently of the preset files.
 PAPER = {

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service import api_python
-from service.params import RenderRequest
-from service.presets import UnknownPreset
+from opaline.local import api as api_python
+from opaline.model.params import RenderRequest
+from opaline.model.presets import UnknownPreset
 
 pytestmark = pytest.mark.gl
 ROOT = Path(__file__).resolve().parent.parent
@@ -36,23 +36,24 @@ def on_thread(backend):
     pool.shutdown()
 
 
-def test_importing_service_stays_light():
-    """`import service` loads no GL, NumPy or pydantic; `service.render` loads them on use."""
-    code = ("import sys, service; heavy = {'moderngl', 'numpy', 'pydantic'} & set(sys.modules); "
-            "assert not heavy, heavy; from service import render, render_array; "
-            "assert render is service.api_python.render and 'moderngl' in sys.modules; "
-            "assert render_array is service.api_python.render_array")
+def test_importing_opaline_stays_light():
+    """`import opaline` loads no GL, NumPy or pydantic; `opaline.render` loads them on use."""
+    code = ("import sys, opaline; heavy = {'moderngl', 'numpy', 'pydantic'} & set(sys.modules); "
+            "assert not heavy, heavy; from opaline import render, render_array; "
+            "import opaline.local.api as api; "
+            "assert render is api.render and 'moderngl' in sys.modules; "
+            "assert render_array is api.render_array")
     result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 0, result.stderr
 
 
-def test_unknown_attribute_of_service_is_an_attribute_error():
-    """The lazy `service.__getattr__` still raises AttributeError for names it does not know."""
-    import service
+def test_unknown_attribute_of_opaline_is_an_attribute_error():
+    """The lazy `opaline.__getattr__` still raises AttributeError for names it does not know."""
+    import opaline
 
     with pytest.raises(AttributeError):
-        service.no_such_thing  # noqa: B018
+        opaline.no_such_thing  # noqa: B018
 
 
 def test_render_dict_gives_a_png_of_the_requested_size(on_thread):
@@ -65,7 +66,7 @@ def test_render_dict_gives_a_png_of_the_requested_size(on_thread):
 
 def test_render_matches_local_renderer_bytes(on_thread, backend):
     """The Python API, a RenderRequest and a dict all give the LocalRenderer's exact bytes."""
-    from service.pipeline import LocalRenderer
+    from opaline.local.pipeline import LocalRenderer
 
     def local_bytes(backend):
         with LocalRenderer(backend) as renderer:
@@ -128,7 +129,7 @@ def test_one_renderer_per_thread_each_correct(on_thread, backend):
 
 def test_another_context_on_the_thread_does_not_corrupt_renders(on_thread, backend):
     """A second GL context made on the same thread (which becomes current) changes nothing."""
-    from service.context import create_context
+    from opaline.gl.context import create_context
 
     def with_intruder(backend):
         before = api_python.render(DISC, backend=backend)

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.params import RenderRequest
-from service.presets import get_preset
-from service.request import resolve
+from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import resolve
 
 pytestmark = pytest.mark.gl
 pytest.importorskip("flip_evaluator")

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from service import reference as ref
-from service.params import Material
+from opaline.model import reference as ref
+from opaline.model.params import Material
 
 PROPERTY = settings(max_examples=40, deadline=None)
 

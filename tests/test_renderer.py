@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from service.params import RenderRequest
-from service.presets import all_presets, get_preset
-from service.request import resolve
+from opaline.model.params import RenderRequest
+from opaline.model.presets import all_presets, get_preset
+from opaline.model.request import resolve
 
 pytestmark = pytest.mark.gl
 PRESETS = sorted(all_presets())

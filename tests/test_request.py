@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from service.params import MATERIAL_FIELDS, RenderFields, RenderRequest
-from service.presets import get_preset
-from service.request import TIERS, CostError, Job, check_cost, resolve
+from opaline.model.params import MATERIAL_FIELDS, RenderFields, RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import TIERS, CostError, Job, check_cost, resolve
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -128,8 +128,8 @@ def test_cache_key_stable_for_equal_requests():
 
 def test_cache_key_stable_across_processes():
     """The key does not depend on the process (no id()- or hash()-seeded parts)."""
-    code = ("from service.params import RenderRequest; from service.presets import get_preset; "
-            "from service.request import resolve; p = get_preset('cd-rom'); "
+    code = ("from opaline.model.params import RenderRequest; from opaline.model.presets import get_preset; "
+            "from opaline.model.request import resolve; p = get_preset('cd-rom'); "
             "print(resolve(RenderRequest(preset='cd-rom', mu_f=3.0), p).cache_key(p.scene_key()))")
     env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONHASHSEED": "12345"}
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,

@@ -8,7 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 import httpx
 import pytest
 
-from service.localserver import LocalServer, ServerError
+from opaline.server.localserver import LocalServer, ServerError
 
 pytestmark = pytest.mark.gl
 

@@ -8,11 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from service import shaders
-from service.params import RenderRequest
-from service.presets import get_preset
-from service.request import resolve
-from service.shaders import ProgramCache, ShaderError, annotate_log, compose, expand
+from opaline import resources
+from opaline.gl import shaders
+from opaline.gl.shaders import ProgramCache, ShaderError, annotate_log, compose, expand
+from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import resolve
 
 LINE = re.compile(r"^#line (\d+) (\d+)$")
 
@@ -34,6 +35,7 @@ def glsl_copy(tmp_path, monkeypatch):
     root = tmp_path / "glsl"
     shutil.copytree(shaders.glsl_root(), root)
     monkeypatch.setattr(shaders, "glsl_root", lambda: root)
+    monkeypatch.setattr(resources, "glsl_root", lambda: root)
     shaders.read_source.cache_clear()
     shaders.sources_digest.cache_clear()
     yield root

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.spectrum import ANCHORS_NM, rgb_weights, rotation_at, sample_wavelengths
+from opaline.model.spectrum import ANCHORS_NM, rgb_weights, rotation_at, sample_wavelengths
 
 
 def test_rotation_passes_through_the_anchors_and_extends_linearly():

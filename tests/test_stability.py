@@ -29,6 +29,11 @@ import numpy as np
 import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
+
+from opaline.model import reference as ref
+from opaline.model.params import Material, RenderRequest
+from opaline.model.presets import Preset, all_presets, get_preset
+from opaline.model.request import resolve
 from stability_cases import (
     ASHIKHMIN,
     DEGENERATE,
@@ -44,11 +49,6 @@ from stability_cases import (
     shading_batch,
     stack,
 )
-
-from service import reference as ref
-from service.params import Material, RenderRequest
-from service.presets import Preset, all_presets, get_preset
-from service.request import resolve
 
 pytestmark = pytest.mark.gl
 
@@ -366,7 +366,7 @@ def test_firefly_detector_catches_injected_spikes(renderer):
 def degenerate_mesh():
     """A sphere whose vertices carry zero, opposed and tangent-parallel normals, zero
     tangents, plus zero-area triangles (repeated corners, collinear and coincident ones)."""
-    from service import geometry
+    from opaline.scene import geometry
 
     base = geometry.sphere(radius=1.0, segments=48, rings=24)
     p = base.positions.astype(np.float64)
@@ -421,7 +421,7 @@ degenerate_scene_names: list[str] = []  # a fresh scene (and upload) per test
 def test_degenerate_mesh_and_normal_map_render_finite(renderer, monkeypatch, with_map, fields):
     """The surface shader's guards (zero interpolated normal, zero texel, degenerate
     tangent) keep a render finite and non-negative, and the guarded parts are shaded."""
-    import service.renderer as renderer_module
+    import opaline.gl.renderer as renderer_module
 
     sphere = get_preset("sphere").model_dump()
     name = f"stability-degenerate-{len(degenerate_scene_names)}"

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from service import uniforms
-from service.params import Material
-from service.shaders import declared_defines
+from opaline.gl import uniforms
+from opaline.gl.shaders import declared_defines
+from opaline.model.params import Material
 
 MATERIALS = [
     Material(),

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from service.localserver import LocalServer, ServerError, loopback_env
+from opaline.server.localserver import LocalServer, ServerError, loopback_env
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = Path("/usr/bin/chromium")

@@ -9,13 +9,13 @@ import time
 import moderngl
 import pytest
 
-from service.cache import ImageCache
-from service.metrics import Metrics
-from service.params import RenderRequest
-from service.presets import get_preset
-from service.request import resolve
-from service.shaders import ShaderError
-from service.worker import (
+from opaline.gl.shaders import ShaderError
+from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import resolve
+from opaline.server.cache import ImageCache
+from opaline.server.metrics import Metrics
+from opaline.server.worker import (
     DeadlineExceeded,
     Overloaded,
     RenderFailed,
@@ -271,7 +271,7 @@ def test_render_seconds_observed_by_label(make_pool):
 @pytest.mark.gl
 def test_real_context_recovers_after_injected_failure(backend):
     """With real GL: a failing render costs the context, and the new context renders correctly."""
-    from service.renderer import Renderer
+    from opaline.gl.renderer import Renderer
 
     made: list[Renderer] = []
 

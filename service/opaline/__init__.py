@@ -1,0 +1,16 @@
+"""Opaline: headless previews of iridescent materials (Kang, Lee, Cho 2014).
+
+``from opaline import render`` gives the Python API (see docs/python.md); it is
+imported on first use so that importing the package stays light.
+"""
+
+__version__ = "0.1.0"
+__all__ = ["__version__", "render", "render_array"]
+
+
+def __getattr__(name: str):
+    if name in ("render", "render_array"):
+        from opaline.local import api as api_python
+
+        return getattr(api_python, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

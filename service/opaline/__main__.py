@@ -1,0 +1,5 @@
+"""``python -m service`` is the ``opaline`` command."""
+
+from opaline.cli.main import main
+
+raise SystemExit(main())

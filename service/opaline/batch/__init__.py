@@ -1,0 +1,1 @@
+"""Batch thumbnails: planning, worker pools, the remote client, progress, sheets."""

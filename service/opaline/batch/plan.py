@@ -1,0 +1,105 @@
+"""A batch's plan and its outputs on disk: what each item renders to, and whether it is current.
+
+Each output ``DIR/NAME.png`` has a sidecar ``DIR/NAME.png.json`` holding the
+cache key of its resolved request (``Job.cache_key``: request, preset scene,
+shader sources, version); the same key means the image is up to date. The
+sidecar is written after the image, so a pair cut short re-renders.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from opaline import __version__
+from opaline.model.materials import Item
+from opaline.model.presets import UnknownPreset, get_preset
+from opaline.model.request import CostError, Job, check_cost, resolve
+from opaline.output.encode import EXTENSIONS
+from opaline.output.files import write_atomic
+
+WRITTEN = ("rendered", "skipped")  # the statuses with an output on disk
+
+
+@dataclass
+class Task:
+    """One item's fate: where it goes, its key, and what happened."""
+
+    item: Item
+    job: Job | None = None
+    key: str | None = None
+    output: Path | None = None
+    status: str = "pending"  # → rendered | skipped | failed | interrupted
+    seconds: float = 0.0
+    error: str | None = None
+
+    @property
+    def sidecar(self) -> Path:
+        assert self.output is not None
+        return self.output.with_name(self.output.name + ".json")
+
+    @property
+    def written(self) -> bool:
+        return self.status in WRITTEN
+
+    def record(self) -> dict[str, Any]:
+        return {"name": self.item.name, "input": self.item.source,
+                "output": str(self.output) if self.written else None,
+                "status": self.status, "seconds": round(self.seconds, 4), "error": self.error,
+                "key": self.key}
+
+
+def plan(items: list[Item], out: Path, *, force: bool = False,
+         cost_budget: int | None = None) -> list[Task]:
+    """A task per item; ``cost_budget=None`` leaves the cost check to the server that renders."""
+    return [plan_one(item, out, force, cost_budget) for item in items]
+
+
+def plan_one(item: Item, out: Path, force: bool, cost_budget: int | None) -> Task:
+    task = Task(item)
+    if item.request is None:
+        task.status, task.error = "failed", item.error
+        return task
+    try:
+        preset = get_preset(item.request.preset)
+        task.job = resolve(item.request, preset)
+        if cost_budget is not None:
+            check_cost(task.job, cost_budget)
+    except (UnknownPreset, CostError) as exc:
+        task.status, task.error = "failed", f"{item.source}: {exc}"
+        return task
+    task.key = task.job.cache_key(preset.scene_key())
+    task.output = out / (item.name + EXTENSIONS[task.job.format])
+    if not force and up_to_date(task):
+        task.status = "skipped"
+    return task
+
+
+def up_to_date(task: Task) -> bool:
+    if task.output is None or not task.output.is_file():
+        return False
+    try:
+        return json.loads(task.sidecar.read_text()).get("key") == task.key
+    except (OSError, ValueError, AttributeError):  # unreadable, not JSON, not a JSON object
+        return False
+
+
+def write_result(task: Task, data: bytes) -> None:
+    """The image first, then its sidecar: an interrupted pair is not up to date."""
+    assert task.output is not None and task.item.request is not None
+    write_atomic(task.output, data)
+    sidecar = {"key": task.key, "input": task.item.source, "opaline": __version__,
+               "request": task.item.request.model_dump(mode="json", exclude_none=True)}
+    write_atomic(task.sidecar, (json.dumps(sidecar, indent=2) + "\n").encode())
+
+
+def remove_temporaries(tasks: list[Task], extra: list[Path]) -> None:
+    """Temporary files ``write_atomic`` may have left for these outputs: a signal that lands
+    between its ``mkstemp`` and its ``try`` leaves one that its own cleanup never sees."""
+    paths = [p for t in tasks if t.output for p in (t.output, t.sidecar)] + extra
+    for path in paths:
+        for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+            tmp.unlink(missing_ok=True)

@@ -1,0 +1,155 @@
+"""``opaline batch``: material files in, thumbnails out, reproducibly and incrementally.
+
+    collect inputs (materials.collect) → plan (batch_plan: resolve, cache key, skip if
+    up to date) → render (batch_pool: a GL thread, spawned processes, or a server)
+    → write image, then sidecar (batch_plan) → summary JSON (+ contact sheet: sheet)
+
+Ctrl-C or SIGTERM stops the run: work in flight is dropped, worker processes
+end, temporary files are removed and the summary, marked interrupted, is
+written with every item not reached as ``interrupted``.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import threading
+import time
+from collections import deque
+from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, wait
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from opaline import __version__
+from opaline.batch.plan import Task, plan, remove_temporaries, write_result
+from opaline.batch.pool import start_pool
+from opaline.batch.progress import PlainProgress, make_progress
+from opaline.batch.sheet import write_contact_sheet
+from opaline.model.materials import collect
+from opaline.output.files import write_atomic
+from opaline.settings import DEFAULT_COST_BUDGET
+
+
+@dataclass
+class Options:
+    out: Path
+    jobs: int = 1
+    overrides: dict[str, Any] = field(default_factory=dict)
+    server: str | None = None
+    backend: str | None = None
+    sheet: bool = False
+    summary: Path | None = None
+    force: bool = False
+    retries: int = 5
+
+    @property
+    def summary_path(self) -> Path:
+        return self.summary or self.out / "summary.json"
+
+
+def run_batch(inputs: list[str | Path], options: Options,
+              progress: PlainProgress | None = None) -> dict[str, Any]:
+    """Render every input; returns the summary (also written to ``options.summary_path``)."""
+    started = time.monotonic()
+    items = collect(inputs, options.overrides, exclude=[options.out, options.summary_path])
+    # With --server the server checks the cost, against its own budget.
+    budget = None if options.server else DEFAULT_COST_BUDGET
+    tasks = plan(items, options.out, force=options.force, cost_budget=budget)
+    progress = progress or make_progress()
+    progress.start(tasks)
+    try:
+        render_all(tasks, options, progress)
+    except KeyboardInterrupt:
+        # A second Ctrl-C must not cut the clean-up short: the summary is written whole.
+        with _signals(signal.SIG_IGN, signal.SIGINT, signal.SIGTERM):
+            progress.close()
+            for task in tasks:
+                if task.status == "pending":
+                    task.status = "interrupted"
+            remove_temporaries(tasks, [options.summary_path])
+            write_summary(tasks, options, started, interrupted=True)
+        raise
+    progress.close()
+    summary = write_summary(tasks, options, started, interrupted=False)
+    if options.sheet:
+        write_contact_sheet(options.out, tasks)
+    return summary
+
+
+def render_all(tasks: list[Task], options: Options, progress: PlainProgress) -> None:
+    """Render every pending task, at most ``2 × jobs`` in flight; results are written here."""
+    queue = deque(t for t in tasks if t.status == "pending")
+    if not queue:
+        return  # nothing to render: no GL context, no worker process
+    pool = start_pool(options.jobs, options.backend, options.server, options.retries)
+    pending: dict[Future, Task] = {}
+    try:
+        while queue or pending:
+            while queue and len(pending) < 2 * options.jobs:
+                task = queue.popleft()
+                pending[pool.submit(task)] = task
+            done, _ = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
+            for future in done:
+                task = pending.pop(future)
+                finish(task, future)
+                progress.advance(task)
+    except BaseException:
+        pool.abort()
+        raise
+    pool.close()
+
+
+def finish(task: Task, future: Future) -> None:
+    try:
+        data, task.seconds, error = future.result()
+    except Exception as exc:  # a worker process died (BrokenProcessPool) or similar
+        data, error = None, f"worker failed: {type(exc).__name__}: {exc}"
+    if data is None:
+        task.status, task.error = "failed", f"{task.item.source}: {error}"
+        return
+    write_result(task, data)
+    task.status = "rendered"
+
+
+def write_summary(tasks: list[Task], options: Options, started: float,
+                  interrupted: bool) -> dict[str, Any]:
+    counts = {s: sum(t.status == s for t in tasks) for s in ("rendered", "skipped", "failed")}
+    if interrupted:
+        counts["interrupted"] = sum(t.status == "interrupted" for t in tasks)
+    summary = {
+        "opaline": __version__,
+        "out": str(options.out),
+        "server": options.server,
+        "jobs": options.jobs,
+        "seconds": round(time.monotonic() - started, 3),
+        "interrupted": interrupted,
+        "counts": counts,
+        "items": [t.record() for t in tasks],
+    }
+    text = json.dumps(summary, indent=2, ensure_ascii=False) + "\n"
+    write_atomic(options.summary_path, text.encode())
+    return summary
+
+
+@contextmanager
+def _signals(handler: Any, *signals: signal.Signals) -> Iterator[None]:
+    """``handler`` for ``signals`` inside the block; only the main thread may set handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    saved = {sig: signal.signal(sig, handler) for sig in signals}
+    try:
+        yield
+    finally:
+        for sig, old in saved.items():
+            signal.signal(sig, old)
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+# Command line.

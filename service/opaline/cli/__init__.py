@@ -1,0 +1,1 @@
+"""The ``opaline`` command line: one module per sub-command family."""

@@ -1,0 +1,1 @@
+"""Rendering in this process: ``LocalRenderer`` and ``from opaline import render``."""

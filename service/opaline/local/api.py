@@ -1,0 +1,94 @@
+"""``from service import render``: one call, a request in, image bytes out (docs/python.md).
+
+    from opaline import render
+    from opaline import render_array
+    png = render({"preset": "cd-rom", "mu_f": 6, "width": 128, "height": 128})
+    linear = render_array({"preset": "nacre"})          # (H, W, 4) float32
+
+Each thread gets its own ``pipeline.LocalRenderer`` (a GL context is current
+on one thread only), made on first use and kept for the next call; ``close()``
+releases the calling thread's renderer. Invalid requests raise ``RequestError``
+(one line per field: name, value, allowed range); an unknown preset raises
+``presets.UnknownPreset``; a request over the cost budget ``request.CostError``.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+
+from opaline.local.pipeline import LocalRenderer
+from opaline.model.params import RenderRequest, describe_errors
+from opaline.model.request import Job
+
+RequestLike = RenderRequest | dict[str, Any] | Path
+
+
+class RequestError(ValueError):
+    """The request is invalid; ``problems`` holds one line per field (name, value, range)."""
+
+    def __init__(self, problems: list[str]) -> None:
+        self.problems = problems
+        super().__init__("; ".join(problems))
+
+
+_local = threading.local()
+
+
+def as_request(request: RequestLike) -> RenderRequest:
+    """A RenderRequest from a model, a dict of its fields, or a material file path."""
+    if isinstance(request, RenderRequest):
+        return request
+    if isinstance(request, Path):
+        from opaline.model.materials import MaterialError, load_material
+
+        try:
+            return load_material(request)
+        except MaterialError as exc:
+            raise RequestError([str(exc)]) from None
+    if not isinstance(request, dict):
+        raise TypeError(f"expected a RenderRequest, a dict or a Path, got {type(request).__name__}")
+    try:
+        return RenderRequest.model_validate(request)
+    except ValidationError as exc:
+        raise RequestError(describe_errors(exc)) from None
+
+
+def renderer(backend: str | None = None) -> LocalRenderer:
+    """This thread's renderer, created on first use (or anew for a different ``backend``:
+    one context per thread, and EGL and OSMesa should not share a process anyway)."""
+    found: LocalRenderer | None = getattr(_local, "renderer", None)
+    if found is not None and getattr(_local, "backend", None) != backend:
+        close()
+        found = None
+    if found is None:
+        found = LocalRenderer(backend)
+        _local.renderer, _local.backend = found, backend
+    return found
+
+
+def render(request: RequestLike, *, backend: str | None = None) -> bytes:
+    """Encoded image bytes (PNG, 16-bit PNG or .npy, as the request's ``format`` says)."""
+    return renderer(backend).render_bytes(as_request(request))
+
+
+def render_array(request: RequestLike, *, backend: str | None = None) -> np.ndarray:
+    """Linear, premultiplied RGBA float32 of shape (height, width, 4)."""
+    return renderer(backend).render_array(as_request(request))
+
+
+def render_job(job: Job, *, backend: str | None = None) -> bytes:
+    """Encoded bytes for a job already resolved (``request.resolve``), as in ``opaline batch``."""
+    return renderer(backend).render_job(job)
+
+
+def close() -> None:
+    """Release the calling thread's renderer and its GL context."""
+    found = getattr(_local, "renderer", None)
+    _local.renderer = _local.backend = None
+    if found is not None:
+        found.close()

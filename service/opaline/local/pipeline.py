@@ -1,0 +1,70 @@
+"""The Python API: a request in, encoded bytes or an array out, no HTTP involved.
+
+    from opaline.local import pipeline
+    with pipeline.LocalRenderer() as r:
+        png = r.render_bytes(RenderRequest(preset="cd-rom", mu_f=6))
+
+One LocalRenderer owns one GL context; use it from the thread that made it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from opaline.gl.renderer import Renderer
+from opaline.model.params import Material, RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import Job, check_cost, resolve
+from opaline.output.encode import encode_frame, encode_mdf
+from opaline.settings import DEFAULT_COST_BUDGET
+
+
+@dataclass
+class Rendered:
+    job: Job
+    data: bytes
+    media_type: str
+
+
+class LocalRenderer:
+    """Renders requests on a private headless context."""
+
+    def __init__(self, backend: str | None = None, cost_budget: int = DEFAULT_COST_BUDGET) -> None:
+        self.renderer = Renderer(backend)
+        self.cost_budget = cost_budget
+
+    def __enter__(self) -> LocalRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self.renderer.release()
+
+    def job(self, request: RenderRequest) -> Job:
+        job = resolve(request, get_preset(request.preset))
+        check_cost(job, self.cost_budget)
+        return job
+
+    def render_job(self, job: Job) -> bytes:
+        frame = self.renderer.render(job)
+        return encode_frame(frame, job.format, alpha=job.transparent)
+
+    def render_bytes(self, request: RenderRequest) -> bytes:
+        return self.render_job(self.job(request))
+
+    def render_array(self, request: RenderRequest) -> np.ndarray:
+        """Linear, premultiplied RGBA float32 (H, W, 4)."""
+        job = replace(self.job(request), format="npy")
+        return self.renderer.render(job).linear
+
+    def mdf_plot(self, material: Material, size: int, wavelengths: int = 0) -> np.ndarray:
+        return self.renderer.mdf_plot(material, size, wavelengths)
+
+    def mdf_bytes(
+        self, material: Material, size: int, fmt: str = "png", wavelengths: int = 0
+    ) -> bytes:
+        return encode_mdf(self.mdf_plot(material, size, wavelengths), fmt)

@@ -1,0 +1,148 @@
+"""Scene presets: TOML files in ``presets/``, validated when loaded.
+
+A preset is a scene (geometry, tangent field, normal map, camera, lights,
+background) plus ``[defaults]``, which parse into the same model as a render
+request's fields: a preset is a request with a scene attached. The merge
+order is the built-in defaults, then the preset's, then the request's.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import tomllib
+from functools import cache
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from opaline.model.params import STRICT, RenderFields, Unit, describe_errors
+from opaline.resources import presets_dir
+from opaline.scene import geometry, normalmaps
+
+Vec3 = tuple[float, float, float]
+NonNegative3 = tuple[
+    Annotated[float, Field(ge=0.0)],
+    Annotated[float, Field(ge=0.0)],
+    Annotated[float, Field(ge=0.0)],
+]
+Colour = tuple[Unit, Unit, Unit]
+
+
+class PresetError(ValueError):
+    """A preset file is missing or invalid; the message names the file and field."""
+
+
+class Camera(BaseModel):
+    model_config = STRICT
+    eye: Vec3
+    target: Vec3 = (0.0, 0.0, 0.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov_deg: Annotated[float, Field(gt=1.0, lt=170.0)] = 35.0
+
+
+class Light(BaseModel):
+    model_config = STRICT
+    type: Literal["point", "directional"]
+    # Point: position. Directional: direction toward the light.
+    position: Vec3
+    irradiance: NonNegative3 = (1.0, 1.0, 1.0)
+
+
+class Generator(BaseModel):
+    """A named generator and its keyword arguments (checked by the generator)."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+    kind: str
+
+    @property
+    def args(self) -> dict[str, Any]:
+        return dict(self.model_extra or {})
+
+
+class Preset(BaseModel):
+    model_config = STRICT
+    name: str
+    description: str
+    figure: str = ""
+    geometry: Generator
+    tangents: Literal["uv", "concentric"] = "uv"
+    normal_map: Generator | None = None
+    rotation_deg: Vec3 = (0.0, 0.0, 0.0)
+    camera: Camera
+    lights: Annotated[list[Light], Field(min_length=1, max_length=8)]
+    background: Colour = (0.0, 0.0, 0.0)
+    ambient: NonNegative3 = (0.0, 0.0, 0.0)
+    defaults: RenderFields = RenderFields()
+
+    def scene_key(self) -> str:
+        """Hash of everything that shapes the scene, for cache keys."""
+        scene = self.model_dump(exclude={"defaults", "description", "figure"}, mode="json")
+        return hashlib.sha256(json.dumps(scene, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def load_preset_file(path: Path) -> Preset:
+    try:
+        data = tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise PresetError(f"preset {path.name}: {exc}") from exc
+    data.setdefault("name", path.stem)
+    try:
+        preset = Preset.model_validate(data)
+    except ValidationError as exc:
+        problems = describe_errors(exc, Preset)
+        raise PresetError(f"preset {path.name}: " + "; ".join(problems)) from exc
+    _check_generators(path.name, preset)
+    return preset
+
+
+def _check_generators(filename: str, preset: Preset) -> None:
+    try:
+        build_assets(preset)
+    except ValueError as exc:
+        raise PresetError(f"preset {filename}: {exc}") from exc
+
+
+_assets: dict[str, tuple[Any, Any]] = {}
+
+
+def build_assets(preset: Preset) -> tuple[Any, Any]:
+    """The preset's mesh and normal map (or None), generated once per scene."""
+    key = preset.scene_key()
+    if key not in _assets:
+        mesh = geometry.build(preset.geometry.kind, **preset.geometry.args)
+        normal_map = None
+        if preset.normal_map is not None:
+            args = preset.normal_map.args
+            if preset.normal_map.kind == "file":
+                args["path"] = str(presets_dir() / args.get("path", ""))
+            normal_map = normalmaps.build(preset.normal_map.kind, **args)
+        _assets[key] = (mesh, normal_map)
+    return _assets[key]
+
+
+@cache
+def all_presets() -> dict[str, Preset]:
+    """Every preset, validated; raises PresetError naming the first bad file."""
+    found = {}
+    for path in sorted(presets_dir().glob("*.toml")):
+        preset = load_preset_file(path)
+        found[preset.name] = preset
+    return found
+
+
+class UnknownPreset(KeyError):
+    def __init__(self, name: str) -> None:
+        self.name = name
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return f"preset={self.name!r} is not known: choose one of {', '.join(all_presets())}"
+
+
+def get_preset(name: str) -> Preset:
+    try:
+        return all_presets()[name]
+    except KeyError:
+        raise UnknownPreset(name) from None

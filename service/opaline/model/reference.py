@@ -1,0 +1,189 @@
+"""Float64 NumPy reference of the shading model (DESIGN.md §1).
+
+Each function mirrors one GLSL function in ``glsl/lib`` of the same name, so
+tests can compare the two path by path. All functions broadcast over arrays.
+
+References: Kang, Lee, Cho 2014 (eqs. 1-4); Ashikhmin & Shirley 2000 for the
+reflectance around the MDF; Schlick 1994 for the Fresnel term.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
+
+EPS_DENOM = 1e-4  # DESIGN §1: every denominator clamped to at least this
+EPS_HALF = 1e-6  # |l + v| below this: no half vector, no specular
+TWO_PI = 2.0 * np.pi
+
+
+def rotate_half(hx, hy, theta):
+    """Eq. 2: rotate the projected half vector counter-clockwise by ``theta``."""
+    c, s = np.cos(theta), np.sin(theta)
+    return c * hx - s * hy, s * hx + c * hy
+
+
+def log1p_ratio(s2):
+    """-log1p(-s2) / s2, which is 1 at s2 = 0 and grows to the rim.
+
+    ``hz**e = exp(e * ln hz)`` with ``ln hz = 0.5 * log1p(-s2)``; dividing by s2
+    here lets the A-S exponent be written from hx², hy² alone (DESIGN §8).
+    """
+    s2 = np.asarray(s2, dtype=np.float64)
+    u = np.clip(1.0 - s2, 1e-12, 1.0)
+    safe = np.where(s2 > 0.0, s2, 1.0)
+    return np.where(s2 > 0.0, -np.log(u) / safe, 1.0)
+
+
+def mdf_ashikhmin(hx, hy, hz, ex, ey):
+    """Eq. 1: sqrt((ex+1)(ey+1))/(2π) · hz^((ex·hx² + ey·hy²)/(hx² + hy²))."""
+    hx2, hy2 = hx * hx, hy * hy
+    s2 = np.minimum(hx2 + hy2, 1.0)
+    log_term = -0.5 * (ex * hx2 + ey * hy2) * log1p_ratio(s2)
+    norm = np.sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI
+    return np.where(hz > 0.0, norm * np.exp(log_term), 0.0)
+
+
+def mdf_multipeak(hx, hy, hz, mu_f, alpha, beta):
+    """Eqs. 3-4: ½·max(hz, 0)·(cos(2π·mu_f·r) + 1), r = sqrt(α·hx² + β·hy²)."""
+    r = np.sqrt(alpha * hx * hx + beta * hy * hy)
+    return 0.5 * np.maximum(hz, 0.0) * (np.cos(TWO_PI * mu_f * r) + 1.0)
+
+
+def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint):
+    """Eq. 4 with the cosine box-filtered over a phase footprint (DESIGN §2).
+
+    The mean of cos(x) over [x - Δ/2, x + Δ/2] is cos(x)·sinc(Δ/2), so the
+    bands fade to their average where a pixel spans more than a period.
+    """
+    r = np.sqrt(alpha * hx * hx + beta * hy * hy)
+    x = TWO_PI * mu_f * r
+    half = 0.5 * np.asarray(footprint, dtype=np.float64)
+    sinc = np.where(
+        half > 1e-4, np.sin(half) / np.where(half > 1e-4, half, 1.0), 1.0 - half * half / 6.0
+    )
+    return 0.5 * np.maximum(hz, 0.0) * (np.cos(x) * sinc + 1.0)
+
+
+def mdf(material, hx, hy, hz):
+    """The material's MDF at an unrotated projected half vector."""
+    if material.mdf == "ashikhmin":
+        return mdf_ashikhmin(hx, hy, hz, material.ex, material.ey)
+    return mdf_multipeak(hx, hy, hz, material.mu_f, material.alpha, material.beta)
+
+
+def mdf_rgb(material, hx, hy, hz, wavelengths=0):
+    """D for R, G, B: the MDF at half vectors rotated by 0, θ1, θ2 (eq. 2), or,
+    with ``wavelengths`` > 0, per wavelength and integrated to linear sRGB."""
+    if wavelengths > 0:
+        thetas = rotation_at(sample_wavelengths(wavelengths), material.theta1, material.theta2)
+        weights = rgb_weights(wavelengths)
+        total = 0.0
+        for theta, weight in zip(thetas, weights, strict=True):
+            rx, ry = rotate_half(hx, hy, theta)
+            total = total + mdf(material, rx, ry, hz)[..., None] * weight
+        return np.maximum(total, 0.0)
+    out = []
+    for theta in (0.0, material.theta1, material.theta2):
+        rx, ry = rotate_half(hx, hy, theta)
+        out.append(mdf(material, rx, ry, hz))
+    return np.stack(out, axis=-1)
+
+
+def fresnel_schlick(f0, cos_theta):
+    cos_theta = np.clip(cos_theta, 0.0, 1.0)
+    return f0 + (1.0 - f0) * (1.0 - cos_theta) ** 5
+
+
+def normalize(v):
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(length, 1e-30)
+
+
+def shading_frame(n, t):
+    """Orthonormal (t, b, n): t made perpendicular to n; a t along n is replaced."""
+    n = normalize(n)
+    t = t - n * np.sum(n * t, axis=-1, keepdims=True)
+    length = np.linalg.norm(t, axis=-1, keepdims=True)
+    # Any perpendicular will do where the tangent field degenerates (sphere poles).
+    fallback_axis = np.where(np.abs(n[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    fallback = np.cross(n, fallback_axis)
+    t = np.where(length > 1e-6, t / np.maximum(length, 1e-30), normalize(fallback))
+    # A short remainder (t nearly along n) is mostly cancellation error: a second
+    # projection makes it perpendicular to working precision ("twice is enough").
+    t = normalize(t - n * np.sum(n * t, axis=-1, keepdims=True))
+    b = np.cross(n, t)
+    return t, b, n
+
+
+def specular_rgb(material, n, t, l, v, wavelengths=0):
+    """``specular`` in the shading frame of ``n`` and ``t``."""
+    return specular(material, shading_frame(n, t), l, v, wavelengths)
+
+
+def specular(material, frame, l, v, wavelengths=0):
+    """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel in a (t, b, n) frame; zero where h is
+    undefined."""
+    t, b, n = frame
+    sum_lv = l + v
+    length = np.linalg.norm(sum_lv, axis=-1, keepdims=True)
+    h = sum_lv / np.maximum(length, 1e-30)
+    hx = np.sum(h * t, axis=-1)
+    hy = np.sum(h * b, axis=-1)
+    hz = np.sum(h * n, axis=-1)
+    d = mdf_rgb(material, hx, hy, hz, wavelengths)
+    vh = np.sum(v * h, axis=-1)
+    nl = np.sum(n * l, axis=-1)
+    nv = np.sum(n * v, axis=-1)
+    f = fresnel_schlick(material.f0, vh)
+    denom = 4.0 * np.maximum(vh, EPS_DENOM) * np.maximum(np.maximum(nl, nv), EPS_DENOM)
+    spec = material.ks * d * (f / denom)[..., None]
+    return np.where(length > EPS_HALF, spec, 0.0)
+
+
+def reflected_radiance(material, n, t, l, v, wavelengths=0):
+    """f·max(n·l, 0) for a light of unit irradiance, per channel (linear RGB)."""
+    frame = shading_frame(n, t)
+    nl = np.sum(frame[2] * l, axis=-1)
+    diffuse = material.kd * np.asarray(material.albedo, dtype=np.float64) / np.pi
+    f = diffuse + specular(material, frame, l, v, wavelengths)
+    return f * np.maximum(nl, 0.0)[..., None]
+
+
+def mdf_plot_coords(size):
+    """Pixel-centre hx, hy, hz of the N×N MDF plot (row 0 at the top, +hy up)."""
+    centres = (np.arange(size, dtype=np.float64) + 0.5) / size * 2.0 - 1.0
+    hx, hy = np.meshgrid(centres, centres[::-1])
+    s2 = hx * hx + hy * hy
+    hz = np.sqrt(np.maximum(1.0 - s2, 0.0))
+    return hx, hy, hz, s2 < 1.0
+
+
+def mdf_plot(material, size, wavelengths=0):
+    """The paper's Figs. 2, 3, 6, 7: D over the projected half-vector disc, R G B."""
+    hx, hy, hz, inside = mdf_plot_coords(size)
+    return np.where(inside[..., None], mdf_rgb(material, hx, hy, hz, wavelengths), 0.0)
+
+
+# Display encoding (glsl/lib/display.glsl)
+
+
+def tonemap(x, mode):
+    x = np.maximum(x, 0.0)
+    if mode == "reinhard":
+        return x / (1.0 + x)
+    if mode == "aces":
+        # Narkowicz 2015 fit of the ACES filmic curve.
+        return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
+    return np.clip(x, 0.0, 1.0)
+
+
+def srgb_encode(x):
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+
+
+def srgb_decode(x):
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))

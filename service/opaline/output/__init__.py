@@ -1,0 +1,1 @@
+"""Encoding images (PNG 8/16-bit, linear .npy) and writing files atomically."""

@@ -1,0 +1,1 @@
+"""Procedural scene assets in NumPy: meshes with tangent frames and normal maps."""

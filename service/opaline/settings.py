@@ -1,0 +1,77 @@
+"""Service settings: one class, read from ``OPALINE_*`` environment variables.
+
+Reached through the cached ``get_settings()`` (and, in the HTTP service, the
+``SettingsDep`` dependency of ``opaline.server.api``), so tests override the
+dependency instead of patching globals. The command line and the Python API
+read the same class: ``OPALINE_COST_BUDGET`` and ``OPALINE_PRESETS_DIR`` mean
+the same everywhere. ``gl_backend`` reads ``OPALINE_GL_BACKEND``, the same
+variable that ``opaline.gl.context`` reads when no backend is passed explicitly.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+from typing import Literal, get_args
+
+from pydantic import Field, field_validator
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+BackendName = Literal["egl", "osmesa", "auto"]
+BACKENDS: tuple[str, ...] = get_args(BackendName)
+# 2048² at 64 samples in RGB: the largest image at the `reference` tier's sample count.
+DEFAULT_COST_BUDGET = 2048 * 2048 * 64 * 3
+
+MAX_PIXELS = 2048  # params.Pixels' upper bound: settings may lower it, never raise it
+
+
+class Settings(BaseSettings):
+    """Everything the HTTP service can be configured with."""
+
+    model_config = SettingsConfigDict(env_prefix="OPALINE_", extra="ignore", frozen=True)
+
+    gl_backend: BackendName = Field(
+        "egl", description="Headless GL backend of the render workers.")
+    host: str = Field("127.0.0.1", description="Address `opaline serve` binds.")
+    port: int = Field(8000, ge=1, le=65535, description="Port `opaline serve` binds.")
+    workers: int = Field(
+        1, ge=1, le=16,
+        description="Render worker threads, one GL context each. 1 is the measured best on a "
+                    "2-core llvmpipe machine (bench/results/http_load.md).")
+    queue_size: int = Field(
+        32, ge=1, le=10_000, description="Jobs waiting for a worker before 503.")
+    deadline_s: float = Field(
+        10.0, gt=0, le=600, description="A job still queued this long after it arrived is dropped.")
+    render_timeout_s: float = Field(
+        60.0, gt=0, le=3600,
+        description="How long a request waits for its render once started, before 503.")
+    retry_after_s: int = Field(1, ge=1, le=3600, description="Retry-After sent with a 503.")
+    cache_bytes: int = Field(
+        256 * 1024 * 1024, ge=0, description="Byte budget of the in-memory image cache (0: off).")
+    cache_max_age_s: int = Field(
+        3600, ge=0, description="Cache-Control max-age of image answers to GET.")
+    max_body_bytes: int = Field(16 * 1024, ge=256, description="Largest accepted request body.")
+    max_width: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image width.")
+    max_height: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image height.")
+    cost_budget: int = Field(
+        DEFAULT_COST_BUDGET, ge=1,
+        description="Largest width×height×samples×max(wavelengths, 3) a request may cost.")
+    max_connections: int = Field(
+        1024, ge=1, description="Open connections uvicorn accepts before answering 503.")
+    presets_dir: Path | None = Field(
+        None, description="Folder of scene presets (TOML) used instead of the built-in ones.")
+    warmup: bool = Field(
+        True, description="Render a tiny image on each worker at start-up, so the first "
+                          "request does not pay for shader compilation.")
+
+    @field_validator("gl_backend", mode="before")
+    @classmethod
+    def _lower(cls, value: object) -> object:
+        return value.strip().lower() if isinstance(value, str) else value  # as context.py reads it
+
+
+@lru_cache
+def get_settings() -> Settings:
+    """The process's settings, read from the environment once."""
+    return Settings()
+
