@@ -38,7 +38,7 @@ sys.path[:0] = [str(ROOT / "bench"), str(ROOT)]
 from accuracy_plot import plot  # noqa: E402
 from accuracy_report import TIER_ORDER, kept_guide, to_csv, to_markdown  # noqa: E402
 from metrics import all_metrics  # noqa: E402
-from opaline.cli.main import write_atomic  # noqa: E402
+from opaline.output.files import write_atomic  # noqa: E402
 
 DOCS = ROOT / "docs"
 # The all-features program is timed on these; "1 spp" (aa none) checks that it keeps the job's AA.
