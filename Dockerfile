@@ -43,7 +43,9 @@ USER opaline
 WORKDIR /home/opaline
 
 EXPOSE 8000
+# /readyz, not /healthz: the container is healthy only while a worker can render
+# (readyz answers 503 when no worker process has a GL context).
 HEALTHCHECK --interval=30s --timeout=5s --start-period=30s --retries=3 \
-    CMD ["python", "-c", "import os, urllib.request; urllib.request.urlopen('http://127.0.0.1:' + os.environ.get('OPALINE_PORT', '8000') + '/healthz', timeout=4)"]
+    CMD ["python", "-c", "import os, urllib.request; urllib.request.urlopen('http://127.0.0.1:' + os.environ.get('OPALINE_PORT', '8000') + '/readyz', timeout=4)"]
 
 ENTRYPOINT ["opaline", "serve", "--host", "0.0.0.0"]

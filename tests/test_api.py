@@ -6,6 +6,7 @@ import io
 import logging
 import threading
 import time
+from functools import partial
 
 import numpy as np
 import pytest
@@ -13,14 +14,13 @@ from fastapi import FastAPI
 from fastapi.testclient import TestClient
 from PIL import Image
 
-from opaline.gl.renderer import Renderer
-from opaline.gl.shaders import ShaderError
 from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.server.api import WEB_DIR, create_app, mount_web
 from opaline.server.errors import PUBLIC_ERRORS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
+from worker_helpers import BrokenRenderer, EchoTask, GateTask, no_gl
 
 pytestmark = pytest.mark.gl
 
@@ -30,7 +30,7 @@ WAIT = 20.0
 
 @pytest.fixture(scope="module")
 def settings(backend) -> Settings:
-    return Settings(gl_backend=backend, warmup=False, workers=1, queue_size=8)
+    return Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1, queue_size=8)
 
 
 @pytest.fixture(scope="module")
@@ -40,6 +40,7 @@ def client(settings):
 
 
 def make_client(backend, **overrides) -> TestClient:
+    overrides.setdefault("calibrate", False)
     return TestClient(create_app(Settings(gl_backend=backend, warmup=False, **overrides)))
 
 
@@ -48,22 +49,10 @@ def sample(client: TestClient, name: str, labels: dict[str, str] | None = None) 
     return value or 0.0
 
 
-class Gate:
-    """A pool task that keeps the (only) worker busy until opened."""
-
-    def __init__(self) -> None:
-        self.entered, self.opened = threading.Event(), threading.Event()
-
-    def __call__(self, renderer) -> bytes:
-        self.entered.set()
-        self.opened.wait(WAIT)
-        return b""
-
-
-def occupy(client: TestClient, key: str = "gate") -> Gate:
-    gate = Gate()
+def occupy(client: TestClient, folder, key: str = "gate") -> GateTask:
+    gate = GateTask(str(folder))
     client.app.state.pool.submit(key, gate)
-    assert gate.entered.wait(WAIT)
+    gate.wait_entered()
     return gate
 
 
@@ -85,14 +74,13 @@ def test_readyz_reports_the_gl_context(client, backend):
     body = client.get("/readyz").json()
     assert body["ready"] is True and body["backend"] == backend
     assert body["renderer"] and body["workers"][0]["state"] == "ready"
+    assert body["workers"][0]["pid"] > 0 and body["workers"][0]["rss_bytes"] > 0
 
 
 def test_readyz_is_503_without_a_context(backend):
     """/readyz is 503 when no worker could make a GL context, and renders answer 503."""
-    def no_gl():
-        raise RuntimeError("no EGL device")
-
-    app = create_app(Settings(gl_backend=backend, warmup=False), renderer_factory=no_gl)
+    app = create_app(Settings(gl_backend=backend, warmup=False, calibrate=False),
+                     renderer_factory=no_gl)
     with TestClient(app) as client:
         assert client.get("/readyz").status_code == 503
         response = client.get(f"/v1/render?{SMALL}")
@@ -367,39 +355,42 @@ def test_settings_come_from_env_and_dependency_overrides(backend, monkeypatch):
 # Load and failure
 
 
-def test_full_queue_is_503_with_retry_after(backend):
+def test_full_queue_is_503_with_retry_after(backend, tmp_path):
     """With the worker busy and the queue full, a new render answers 503 with Retry-After."""
     with make_client(backend, queue_size=1) as client:
-        gate = occupy(client)
-        client.app.state.pool.submit("queued", lambda renderer: b"")
+        gate = occupy(client, tmp_path)
+        client.app.state.pool.submit("queued", EchoTask())
         response = client.get(f"/v1/render?{SMALL}&mu_f=1.25")
-        gate.opened.set()
+        gate.open()
         assert response.status_code == 503 and response.headers["retry-after"] == "1"
         assert sample(client, "opaline_rejected_requests_total", {"reason": "queue_full"}) == 1
+        end = time.monotonic() + WAIT
+        while client.app.state.pool.depth() and time.monotonic() < end:  # the queue drains
+            time.sleep(0.01)
         assert client.get(f"/v1/render?{SMALL}&mu_f=1.25").status_code == 200
 
 
-def test_request_past_deadline_is_503(backend):
+def test_request_past_deadline_is_503(backend, tmp_path):
     """A request that waited in the queue past deadline_s is dropped and answers 503."""
-    with make_client(backend, deadline_s=0.1) as client:
-        gate = occupy(client)
+    with make_client(backend, deadline_s=0.3) as client:
+        gate = occupy(client, tmp_path)
         answers: list = []
         asker = threading.Thread(
             target=lambda: answers.append(client.get(f"/v1/render?{SMALL}&mu_f=1.75")))
         asker.start()
-        time.sleep(0.3)
-        gate.opened.set()
+        time.sleep(0.6)
+        gate.open()
         asker.join(WAIT)
         assert answers[0].status_code == 503 and "Retry-After" in answers[0].headers
         assert sample(client, "opaline_rejected_requests_total", {"reason": "deadline"}) == 1
         assert sample(client, "opaline_render_seconds_count", {"preset": "sphere"}) == 0
 
 
-def test_identical_concurrent_requests_render_once(backend):
+def test_identical_concurrent_requests_render_once(backend, tmp_path):
     """N identical concurrent requests get the same image from a single render."""
     count = 6
     with make_client(backend) as client:
-        gate = occupy(client)
+        gate = occupy(client, tmp_path)
         url = f"/v1/render?preset=perturbed-cube&{SMALL}"
         answers: list = []
         askers = [threading.Thread(target=lambda: answers.append(client.get(url)))
@@ -409,7 +400,7 @@ def test_identical_concurrent_requests_render_once(backend):
         end = time.monotonic() + WAIT
         while sample(client, "opaline_cache_misses_total") < count and time.monotonic() < end:
             time.sleep(0.01)
-        gate.opened.set()
+        gate.open()
         for asker in askers:
             asker.join(WAIT)
         assert [a.status_code for a in answers] == [200] * count
@@ -418,15 +409,10 @@ def test_identical_concurrent_requests_render_once(backend):
         assert renders == 1
 
 
-class BrokenRenderer(Renderer):
-    def render(self, job, preset=None):
-        raise ShaderError("surface.glsl:12: error: SECRET-COMPILE-LOG")
-
-
 def test_render_failure_is_500_without_the_log(backend, caplog):
     """A shader failure answers 500 with an incident id; the compile log stays in the server log."""
-    app = create_app(Settings(gl_backend=backend, warmup=False),
-                     renderer_factory=lambda: BrokenRenderer(backend))
+    app = create_app(Settings(gl_backend=backend, warmup=False, calibrate=False),
+                     renderer_factory=partial(BrokenRenderer, backend))
     with caplog.at_level(logging.ERROR), TestClient(app) as client:
         response = client.get(f"/v1/render?{SMALL}")
         assert response.status_code == 500

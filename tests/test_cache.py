@@ -76,7 +76,7 @@ def test_concurrent_puts_keep_the_count_exact():
         thread.start()
     for thread in threads:
         thread.join()
-    stored = sum(len(cache._items[k]) for k in list(cache._items))
+    stored = sum(len(data) for data in cache._items.values())
     assert cache.size_bytes == stored <= 5_000
 
 

@@ -36,15 +36,35 @@ class Settings(BaseSettings):
     port: int = Field(8000, ge=1, le=65535, description="Port `opaline serve` binds.")
     workers: int = Field(
         1, ge=1, le=16,
-        description="Render worker threads, one GL context each. 1 is the measured best on a "
+        description="Render worker processes, one GL context each. 1 is the measured best on a "
                     "2-core llvmpipe machine (bench/results/http_load.md).")
+    lp_threads: int | None = Field(
+        None, ge=1, le=256,
+        description="llvmpipe threads per worker (LP_NUM_THREADS); default: cores ÷ workers.")
     queue_size: int = Field(
         32, ge=1, le=10_000, description="Jobs waiting for a worker before 503.")
     deadline_s: float = Field(
-        10.0, gt=0, le=600, description="A job still queued this long after it arrived is dropped.")
+        10.0, gt=0, le=600,
+        description="Longest a request may wait for its image. A job predicted to take longer "
+                    "is refused at once (422), one that would miss it behind the queue gets "
+                    "503, and a job still queued when it passes leaves the queue (503).")
     render_timeout_s: float = Field(
-        60.0, gt=0, le=3600,
-        description="How long a request waits for its render once started, before 503.")
+        30.0, gt=0, le=3600,
+        description="A render running longer than this has its worker killed and replaced "
+                    "(the watchdog); the request gets 503.")
+    calibrate: bool = Field(
+        True, description="Time a few renders per preset at start-up to predict render times.")
+    worker_max_renders: int = Field(
+        1000, ge=1, description="A worker is recycled after this many renders.")
+    worker_max_rss_mb: int = Field(
+        1024, ge=256, description="A worker whose memory passes this after a render is recycled.")
+    worker_programs: int = Field(
+        64, ge=4, le=4096, description="Shader variants a worker keeps compiled (LRU).")
+    worker_scene_mb: int = Field(
+        128, ge=8, description="Bytes of uploaded meshes and normal maps a worker keeps (LRU).")
+    worker_target_mb: int = Field(
+        256, ge=218, description="Bytes of framebuffers a worker keeps (LRU); at least one "
+                                 "2048² set (218 MB).")
     retry_after_s: int = Field(1, ge=1, le=3600, description="Retry-After sent with a 503.")
     cache_bytes: int = Field(
         256 * 1024 * 1024, ge=0, description="Byte budget of the in-memory image cache (0: off).")
@@ -75,3 +95,18 @@ def get_settings() -> Settings:
     """The process's settings, read from the environment once."""
     return Settings()
 
+
+
+# What the HTTP process holds besides its image cache (Python, FastAPI, NumPy, pydantic),
+# and what one render may hold on top of a worker's limit before it is recycled: the
+# largest frame read back and encoded (2048² RGBA float32, four copies at most).
+HTTP_BASE_BYTES = 256 * 1024 * 1024
+FRAME_BYTES = 4 * 2048 * 2048 * 16
+
+
+def memory_budget_bytes(settings: Settings) -> int:
+    """The most memory the service and its workers use together, whatever the requests:
+    every cache is an LRU under its budget, and a worker past its limit is recycled."""
+    mib = 1024 * 1024
+    per_worker = settings.worker_max_rss_mb * mib + FRAME_BYTES
+    return HTTP_BASE_BYTES + settings.cache_bytes + 2 * FRAME_BYTES + settings.workers * per_worker

@@ -1,100 +1,86 @@
-"""Where a batch renders: one GL thread, spawn-started processes, or HTTP threads.
+"""Where a batch renders: this machine's worker processes, or an Opaline server.
 
-Every pool takes a planned ``batch_plan.Task`` and gives a future of
-``(data, seconds, error)``: a failed render fails its item, not the batch, and
-no exception has to cross a process. Worker processes use the ``spawn`` start
-method and make their GL context inside the worker: a context made before a
-fork makes the children's contexts hang (DESIGN §8).
+Every pool takes a planned ``batch.plan.Task`` and gives a future of
+``(data, seconds, error)``: a failed render fails its item, not the batch.
+Local renders go through the same supervised worker processes as the HTTP
+service (``opaline.workers``): spawned, a GL context each, killed past the
+time limit, and gone within a second when the batch itself is killed.
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
-import signal
 import time
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
+from functools import partial
 from typing import TYPE_CHECKING
+
+from opaline.workers.errors import RenderFailed
+from opaline.workers.pool import Job, WorkerPool
+from opaline.workers.tasks import ImageTask
 
 if TYPE_CHECKING:
     from opaline.batch.client import RemoteRenderer
     from opaline.batch.plan import Task
     from opaline.model.params import RenderRequest
-    from opaline.model.request import Job
 
 Outcome = tuple[bytes | None, float, str | None]
+NO_DEADLINE_S = 1e9  # a batch waits for its own work; only the per-render limit applies
+RENDER_LIMIT_S = 600.0
 
 
 def start_pool(jobs: int, backend: str | None = None, server: str | None = None,
-               retries: int = 5) -> Pool:
-    """``jobs`` renders at once: on ``server`` if given, else on this machine's GL."""
+               retries: int = 5) -> GLProcesses | HttpThreads:
+    """``jobs`` renders at once: on ``server`` if given, else in local worker processes."""
     if server:
         return HttpThreads(server, jobs, retries)
-    if jobs == 1:
-        return GLThread(backend)
     return GLProcesses(jobs, backend)
 
 
-class Pool:
-    """Renders tasks on this machine's GL (``_render_local``) unless a subclass sends them on."""
-
-    executor: Executor
-    backend: str | None = None
-
-    def submit(self, task: Task) -> Future:
-        return self.executor.submit(_render_local, task.job, self.backend)
-
-    def close(self) -> None:
-        """Finish the work in flight, then release the workers."""
-        self.executor.shutdown(wait=True)
-
-    def abort(self) -> None:
-        """Stop now: drop the queued work."""
-        self.executor.shutdown(wait=False, cancel_futures=True)
-
-
-class GLThread(Pool):
-    """One thread that owns the GL context, in this process."""
-
-    def __init__(self, backend: str | None) -> None:
-        self.backend = backend
-        self.executor = ThreadPoolExecutor(1, thread_name_prefix="opaline-gl",
-                                           initializer=_warm_up, initargs=(backend,))
-
-    def close(self) -> None:
-        from opaline.local import api as api_python
-
-        self.executor.submit(api_python.close)  # the GL thread releases its own context
-        super().close()
-
-
-class GLProcesses(Pool):
-    """``jobs`` spawned processes, a GL context each, the cores shared between their llvmpipes."""
+class GLProcesses:
+    """``jobs`` worker processes, a GL context each, the cores shared between their llvmpipes."""
 
     def __init__(self, jobs: int, backend: str | None) -> None:
-        self.backend = backend
-        lp_threads = max(1, (os.cpu_count() or 1) // jobs)
-        self.executor = ProcessPoolExecutor(
-            jobs, mp_context=multiprocessing.get_context("spawn"),
-            initializer=_init_process, initargs=(backend, lp_threads))
+        import os
+
+        from opaline.gl.renderer import Renderer
+
+        self.pool = WorkerPool(partial(Renderer, backend), workers=jobs, queue_size=1 << 20,
+                               deadline_s=NO_DEADLINE_S, render_timeout_s=RENDER_LIMIT_S,
+                               lp_threads=max(1, (os.cpu_count() or 1) // jobs), calibrate=False)
+        self.pool.start()
+
+    def submit(self, task: Task) -> Future:
+        from opaline.model.presets import get_preset
+
+        outcome: Future = Future()
+        try:
+            job = self.pool.submit(task.key, ImageTask(task.job, get_preset(task.job.preset)))
+        except Exception as exc:  # no worker has a context: the item fails with the reason
+            outcome.set_result((None, 0.0, f"{type(exc).__name__}: {exc}"))
+            return outcome
+        job.future.add_done_callback(partial(_settle, job, outcome))
+        return outcome
+
+    def close(self) -> None:
+        """The work in flight is done by now (the batch waited for it): release the workers."""
+        self.pool.stop()
 
     def abort(self) -> None:
-        """Stop now, the renders in flight too: end the worker processes."""
-        # shutdown() forgets the processes (``_processes = None``): take them first.
-        processes = list((getattr(self.executor, "_processes", None) or {}).values())
-        super().abort()
-        for process in processes:
-            process.terminate()
-        # Wait for them here, bounded, so abort() returns with no worker left running;
-        # one stuck in a driver call that ignores SIGTERM gets SIGKILL.
-        for process in processes:
-            process.join(timeout=5)
-            if process.is_alive():
-                process.kill()
-                process.join(timeout=5)
+        """Stop now: drop the queued work and end the worker processes."""
+        self.pool.stop(timeout=5.0)
 
 
-class HttpThreads(Pool):
+def _settle(job: Job, outcome: Future, done: Future) -> None:
+    exc = done.exception()
+    if exc is None:
+        outcome.set_result((done.result(), job.seconds, None))
+    elif isinstance(exc, RenderFailed):
+        outcome.set_result((None, job.seconds, f"{exc} (see the log above)"))
+    else:
+        outcome.set_result((None, job.seconds, f"{type(exc).__name__}: {exc}"))
+
+
+class HttpThreads:
     """``jobs`` threads sending requests to an Opaline server, sharing one HTTP client."""
 
     def __init__(self, server: str, jobs: int, retries: int) -> None:
@@ -107,25 +93,12 @@ class HttpThreads(Pool):
         return self.executor.submit(_render_remote, self.remote, task.item.request)
 
     def close(self) -> None:
-        super().close()
+        self.executor.shutdown(wait=True)
         self.remote.close()
 
     def abort(self) -> None:
-        super().abort()
+        self.executor.shutdown(wait=False, cancel_futures=True)
         self.remote.close()
-
-
-# What runs in a worker.
-
-def _render_local(job: Job, backend: str | None) -> Outcome:
-    from opaline.local import api as api_python
-
-    start = time.perf_counter()
-    try:
-        data = api_python.render_job(job, backend=backend)
-    except Exception as exc:  # a shader or context failure fails this item, not the batch
-        return None, time.perf_counter() - start, f"{type(exc).__name__}: {exc}"
-    return data, time.perf_counter() - start, None
 
 
 def _render_remote(remote: RemoteRenderer, request: RenderRequest) -> Outcome:
@@ -137,20 +110,3 @@ def _render_remote(remote: RemoteRenderer, request: RenderRequest) -> Outcome:
     except RemoteError as exc:
         return None, time.perf_counter() - start, str(exc)
     return data, time.perf_counter() - start, None
-
-
-def _init_process(backend: str | None, lp_threads: int) -> None:
-    """In a spawned worker: the parent handles Ctrl-C; share the cores between llvmpipes."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    os.environ.setdefault("LP_NUM_THREADS", str(lp_threads))  # llvmpipe reads it at _warm_up
-    _warm_up(backend)
-
-
-def _warm_up(backend: str | None) -> None:
-    """Make this worker's GL context now, so that item times are render times."""
-    from opaline.local import api as api_python
-
-    try:
-        api_python.renderer(backend)
-    except Exception:  # each item's render reports the failure with its message
-        pass

@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", help="address to bind (default $OPALINE_HOST or 127.0.0.1)")
     serve.add_argument("--port", type=int, help="port to bind (default $OPALINE_PORT or 8000)")
     serve.add_argument("--workers", type=int,
-                       help="render worker threads, one GL context each (default 1)")
+                       help="render worker processes, one GL context each (default 1)")
     serve.add_argument("--queue-size", type=int, help="jobs that may wait before 503 (default 32)")
     add_common(serve)
     serve.add_argument("--log-level", default="info",

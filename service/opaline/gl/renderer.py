@@ -8,7 +8,7 @@ thread, or the service's render worker).
 from __future__ import annotations
 
 import logging
-from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import moderngl
@@ -18,14 +18,33 @@ from opaline.gl import uniforms
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
 from opaline.gl.shaders import ProgramCache
+from opaline.lru import BudgetLRU
 from opaline.model.params import Material
 from opaline.model.presets import Preset, build_assets, get_preset
 from opaline.model.request import Job
 from opaline.model.sampling import sample_offsets
 
 log = logging.getLogger(__name__)
-MAX_TARGET_SIZES = 4
 NORMAL_MAP_UNIT = 1
+TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
+
+
+class Cancelled(Exception):
+    """The render was stopped between samples because nobody waits for it any more."""
+
+
+@dataclass(frozen=True)
+class RenderBudgets:
+    """What one renderer keeps for reuse, each an LRU bounded by count and bytes.
+
+    The target budget must hold one 2048² set (about 218 MB) so that the largest
+    allowed image can render; everything else is evicted oldest first."""
+
+    max_programs: int = 64
+    max_scenes: int = 16
+    scene_bytes: int = 128 * 1024 * 1024
+    max_target_sizes: int = 4
+    target_bytes: int = 2048 * 2048 * TARGET_BYTES_PER_PIXEL
 
 
 @dataclass
@@ -48,6 +67,10 @@ class Targets:
         self.accum_fbo = ctx.framebuffer([self.accum_tex])
         self.display_tex = ctx.texture(size, 4, dtype="f4")
         self.display_fbo = ctx.framebuffer([self.display_tex])
+
+    @property
+    def nbytes(self) -> int:
+        return self.size[0] * self.size[1] * TARGET_BYTES_PER_PIXEL
 
     def release(self) -> None:
         for obj in (
@@ -78,6 +101,9 @@ class SceneGPU:
             self.normal_map.build_mipmaps()
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.normal_map.repeat_x = self.normal_map.repeat_y = True
+        # Mipmaps add a third to the normal map.
+        self.nbytes = self.vbo.size + self.ibo.size + (
+            self.normal_map.width * self.normal_map.height * 12 * 4 // 3 if self.normal_map else 0)
         self._vaos: dict[int, moderngl.VertexArray] = {}
 
     def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
@@ -87,6 +113,11 @@ class SceneGPU:
             found = ctx.vertex_array(program, [layout], index_buffer=self.ibo, skip_errors=True)
             self._vaos[program.glo] = found
         return found
+
+    def drop_vao(self, program_glo: int) -> None:
+        vao = self._vaos.pop(program_glo, None)
+        if vao is not None:
+            vao.release()
 
     def release(self) -> None:
         for vao in self._vaos.values():
@@ -99,30 +130,56 @@ class SceneGPU:
 class Renderer:
     """Draws jobs, MDF plots and BRDF probes on its own headless context."""
 
-    def __init__(self, backend: str | None = None, gl: GLContext | None = None) -> None:
+    def __init__(self, backend: str | None = None, gl: GLContext | None = None,
+                 budgets: RenderBudgets | None = None) -> None:
         self.gl = gl or create_context(backend)
         self.ctx = self.gl.ctx
-        self.programs = ProgramCache(self.ctx)
-        self._targets: OrderedDict[tuple[int, int], Targets] = OrderedDict()
-        self._scenes: dict[str, SceneGPU] = {}
+        self.budgets = budgets = budgets or RenderBudgets()
+        self._targets: BudgetLRU[tuple[int, int], Targets] = BudgetLRU(
+            budgets.max_target_sizes, budgets.target_bytes, release=Targets.release)
+        self._scenes: BudgetLRU[str, SceneGPU] = BudgetLRU(
+            budgets.max_scenes, budgets.scene_bytes, release=SceneGPU.release)
         self._empty_vao: dict[int, moderngl.VertexArray] = {}
         self._flat_normal: moderngl.Texture | None = None
+        self.programs = ProgramCache(self.ctx, budgets.max_programs, self._forget_program)
 
     # Resources
 
     def targets(self, size: tuple[int, int]) -> Targets:
-        found = self._targets.pop(size, None) or Targets(self.ctx, size)
-        self._targets[size] = found
-        while len(self._targets) > MAX_TARGET_SIZES:
-            _, old = self._targets.popitem(last=False)
-            old.release()
+        found = self._targets.get(size)
+        if found is None:
+            found = Targets(self.ctx, size)
+            if not self._targets.put(size, found, found.nbytes):
+                found.release()
+                raise ValueError(f"{size[0]}×{size[1]} targets exceed the renderer's "
+                                 f"budget of {self.budgets.target_bytes} bytes")
         return found
 
     def scene(self, preset: Preset) -> SceneGPU:
         key = preset.scene_key()
-        if key not in self._scenes:
-            self._scenes[key] = SceneGPU(self.ctx, preset)
-        return self._scenes[key]
+        found = self._scenes.get(key)
+        if found is None:
+            found = SceneGPU(self.ctx, preset)
+            if not self._scenes.put(key, found, found.nbytes):
+                found.release()
+                raise ValueError(f"scene {preset.name} exceeds the renderer's budget of "
+                                 f"{self.budgets.scene_bytes} bytes")
+        return found
+
+    def _forget_program(self, program: moderngl.Program) -> None:
+        for scene in self._scenes.values():
+            scene.drop_vao(program.glo)
+        vao = self._empty_vao.pop(program.glo, None)
+        if vao is not None:
+            vao.release()
+
+    def cache_stats(self) -> dict[str, int]:
+        """Sizes and evictions of what this renderer keeps (reported by render workers)."""
+        return {"programs": len(self.programs), "program_evictions": self.programs.evictions,
+                "scenes": len(self._scenes), "scene_bytes": self._scenes.size_bytes,
+                "scene_evictions": self._scenes.evictions, "targets": len(self._targets),
+                "target_bytes": self._targets.size_bytes,
+                "target_evictions": self._targets.evictions}
 
     def flat_normal_map(self) -> moderngl.Texture:
         """A 1×1 map of the unperturbed normal, for the all-features baseline."""
@@ -145,15 +202,17 @@ class Renderer:
 
     # Scenes
 
-    def render(self, job: Job, preset: Preset | None = None, all_features: bool = False) -> Frame:
+    def render(self, job: Job, preset: Preset | None = None, all_features: bool = False,
+               should_stop: Callable[[], bool] | None = None) -> Frame:
         """Draw a job. ``all_features`` compiles every optional feature in (with neutral
-        values) instead of the scene's own variant: the benchmark's baseline."""
+        values) instead of the scene's own variant: the benchmark's baseline.
+        ``should_stop`` is asked between samples; when it says so, ``Cancelled`` is raised."""
         self.gl.make_current()
         preset = preset or get_preset(job.preset)
         size = (job.width, job.height)
         targets = self.targets(size)
         offsets = sample_offsets(job.samples)
-        self._draw_samples(job, preset, targets, offsets, all_features)
+        self._draw_samples(job, preset, targets, offsets, all_features, should_stop)
         # One sample is left in the sample target; more are summed in the accumulation target.
         if len(offsets) == 1:
             fbo, source = targets.sample_fbo, targets.sample_tex
@@ -179,6 +238,7 @@ class Renderer:
         targets: Targets,
         offsets: np.ndarray,
         all_features: bool = False,
+        should_stop: Callable[[], bool] | None = None,
     ) -> None:
         ctx = self.ctx
         defines = self.surface_defines(job, preset)
@@ -221,7 +281,9 @@ class Renderer:
             accumulate["u_sample"].value = 0
             targets.accum_fbo.use()
             targets.accum_fbo.clear(0.0, 0.0, 0.0, 0.0)
-        for dx, dy in offsets:
+        for index, (dx, dy) in enumerate(offsets):
+            if index and should_stop is not None and should_stop():
+                raise Cancelled(f"stopped after {index} of {len(offsets)} samples")
             targets.sample_fbo.use()
             targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             ctx.enable(moderngl.DEPTH_TEST)
@@ -323,10 +385,9 @@ class Renderer:
         self.gl.make_current()
         for vao in self._empty_vao.values():
             vao.release()
-        for scene in self._scenes.values():
-            scene.release()
-        for targets in self._targets.values():
-            targets.release()
+        self._empty_vao.clear()
+        self._scenes.clear()
+        self._targets.clear()
         if self._flat_normal is not None:
             self._flat_normal.release()
         self.programs.release()

@@ -1,198 +1,45 @@
-"""The HTTP API: thin routes over request → cache → render workers → response.
+"""The HTTP service: the app factory, its lifespan, and the operational routes.
 
-    uvicorn --factory service.api:create_app      (or: opaline serve)
+    uvicorn --factory opaline.server.api:create_app      (or: opaline serve)
 
-Each route parses its input into the models of ``service.params``, resolves
-it to a ``Job`` (``service.request``), answers from the cache or through the
-worker pool (``service.worker``), and leaves every failure to the handlers
-of ``service.errors``, which give each a public face: 422 with one line per
-problem, 404 for an unknown preset, 413, 503 with Retry-After, 500 with an
-incident id (the traceback goes only to the server log).
+Image routes live in ``render_routes``; failures get their public face in
+``errors``. The HTTP process never touches GL: renders run in the worker
+processes of ``opaline.workers``, so the event loop answers within
+milliseconds whatever a render does.
 """
 
 from __future__ import annotations
 
 import asyncio
-from collections.abc import Callable
+import os
 from contextlib import asynccontextmanager
-from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Depends, FastAPI, Query, Request
+from fastapi import APIRouter, Depends, FastAPI
 from fastapi.responses import FileResponse, RedirectResponse, Response
-from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, Field
 
 from opaline import __version__
 from opaline.gl.camera import key_light_direction
-from opaline.gl.renderer import Renderer
-from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
+from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
-from opaline.model.request import TIERS, Job, check_cost, check_plot_cost, resolve
-from opaline.model.spectrum import rgb_weights
-from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
-from opaline.server.cache import ImageCache, etag, matches, mdf_key
-from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, install
+from opaline.model.request import resolve
+from opaline.server.cache import ImageCache
+from opaline.server.errors import Problem, install
 from opaline.server.metrics import Metrics
-from opaline.server.queries import MdfQuery, RenderQuery
-from opaline.server.worker import Task, WorkerPool, image_task, mdf_task
-from opaline.settings import Settings, get_settings
+from opaline.server.render_routes import router as render_router
+from opaline.server.schemas import Health, PresetInfo, Readiness
+from opaline.server.service import Service, SettingsDep, get_service
+from opaline.settings import Settings, get_settings, memory_budget_bytes
+from opaline.workers.pool import WorkerPool
+from opaline.workers.tasks import ImageTask
 
 WEB_DIR = Path(__file__).resolve().parent / "web"
-MDF_LABEL = "mdf-plot"  # the render-latency label of MDF plots
-
-SettingsDep = Annotated[Settings, Depends(get_settings)]
-
-
-class PresetInfo(BaseModel):
-    """A preset as the API shows it."""
-
-    name: str
-    description: str
-    figure: str
-    geometry: dict[str, Any] = Field(description="Geometry generator and its arguments.")
-    tangents: str
-    normal_map: dict[str, Any] | None
-    defaults: dict[str, Any] = Field(description="The fields the preset sets itself.")
-    resolved: dict[str, Any] = Field(
-        description="What a request naming only this preset renders: every value resolved.")
-    key_light: dict[str, float] | None = Field(
-        None, description="Where the preset puts its key light, in degrees, as light_azimuth "
-        "and light_elevation measure them.")
-
-
-class Readiness(BaseModel):
-    """What /readyz answers, with 200 or 503 alike."""
-
-    ready: bool
-    backend: str | None = Field(description="GL backend of the first ready worker.")
-    renderer: str | None = Field(description="GL renderer string of the first ready worker.")
-    queue_depth: int = Field(description="Jobs waiting for a render worker.")
-    workers: list[dict[str, Any]] = Field(
-        description="Each worker: name, state, restarts, its GL context's description, and "
-        "the last error when it has no context.")
-
-
-# Services the routes depend on
-
-
-@dataclass
-class Service:
-    settings: Settings
-    pool: WorkerPool
-    cache: ImageCache
-    metrics: Metrics
-
-    @property
-    def wait_s(self) -> float:
-        return self.settings.deadline_s + self.settings.render_timeout_s
-
-
-def get_service(request: Request, settings: SettingsDep) -> Service:
-    state = request.app.state
-    return Service(settings, state.pool, state.cache, state.metrics)
-
-
 ServiceDep = Annotated[Service, Depends(get_service)]
-
-
-def _over_limit(name: str, value: int, limit: int) -> str:
-    return f"{name}={value} is out of range: allowed [16 … {limit}] on this service"
-
-
-def check_limits(job: Job, settings: Settings) -> None:
-    problems = [_over_limit(name, value, limit)
-                for name, value, limit in (("width", job.width, settings.max_width),
-                                           ("height", job.height, settings.max_height))
-                if value > limit]
-    if problems:
-        raise LimitError(problems)
-    check_cost(job, settings.cost_budget)
-
-
-def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
-    size = min(settings.max_width, settings.max_height)
-    if params.size > size:
-        raise LimitError([_over_limit("size", params.size, size)])
-    check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
-
-
-async def answer_image(svc: Service, request: Request, key: str, task: Task, label: str,
-                       fmt: str, filename: str) -> Response:
-    """The image under ``key``: 304, from the cache, or rendered by a worker."""
-    tag = etag(key, svc.pool.identity)
-    headers = {"ETag": tag}
-    if request.method == "GET":
-        headers["Cache-Control"] = f"public, max-age={svc.settings.cache_max_age_s}"
-        if matches(request.headers.get("if-none-match"), tag):
-            return Response(status_code=304, headers=headers)
-    data = svc.cache.get(key)
-    if data is not None:
-        svc.metrics.cache_hits.inc()
-    else:
-        svc.metrics.cache_misses.inc()
-        data = await svc.pool.render(key, task, label, timeout=svc.wait_s)
-    headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
-    return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
-
-
-async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
-    preset = get_preset(params.preset)
-    job = resolve(params, preset)
-    check_limits(job, svc.settings)
-    key = job.cache_key(preset.scene_key())
-    return await answer_image(svc, request, key, image_task(job, preset), preset.name,
-                              job.format, preset.name)
-
-
-# Routes
-
-IMAGE = {"schema": {"type": "string", "format": "binary"}}
-ETAG = {"ETag": {"description": "Strong validator of this image as this service draws it; "
-                                "a GET that sends it back in If-None-Match gets 304.",
-                 "schema": {"type": "string"}}}
-CONDITIONAL: dict[int | str, dict[str, Any]] = {
-    304: {"description": "Not modified: If-None-Match matched the ETag."}}
-RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
-    200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
-    404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
-    413: {"model": Problem, "description": "Request body too large."},
-    **ERROR_RESPONSES,
-}
-MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
-    200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
-    **CONDITIONAL, **ERROR_RESPONSES,
-}
 router = APIRouter()
 
-
-@router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
-             summary="Render a preset with material overrides (JSON body)")
-async def render_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, body)
-
-
-@router.get("/v1/render", tags=["render"], response_class=Response,
-            responses={**RENDER_RESPONSES, **CONDITIONAL},
-            summary="Render a preset with material overrides (query string, for <img src>)")
-async def render_get(params: Annotated[RenderQuery, Query()], request: Request,
-                     svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, params)
-
-
-@router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
-            summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
-async def mdf_get(params: Annotated[MdfQuery, Query()], request: Request,
-                  svc: ServiceDep) -> Response:
-    check_mdf_limits(params, svc.settings)
-    material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
-    key = mdf_key(material, params.size, params.format, params.wavelengths)
-    task = mdf_task(material, params.size, params.format, params.wavelengths)
-    return await answer_image(svc, request, key, task, MDF_LABEL, params.format, "mdf")
+__all__ = ["SettingsDep", "WEB_DIR", "create_app", "mount_web"]
 
 
 def preset_info(preset: Preset) -> PresetInfo:
@@ -221,20 +68,28 @@ async def presets_one(name: str) -> PresetInfo:
     return preset_info(get_preset(name))
 
 
-@router.get("/healthz", tags=["operations"], summary="The process is alive")
-async def healthz() -> dict[str, str]:
-    return {"status": "ok"}
+@router.get("/healthz", tags=["operations"], summary="Liveness: the process answers",
+            description="200 while the HTTP process and its event loop answer, whatever the "
+                        "render workers do: a liveness probe (restart the container if it "
+                        "fails). Whether the service can render is /readyz.")
+async def healthz() -> Health:
+    return Health(status="ok")
 
 
-@router.get("/readyz", tags=["operations"], summary="A render worker has a live GL context",
-            responses={503: {"model": Readiness, "description": "No worker has a GL context."}})
+@router.get("/readyz", tags=["operations"], summary="Readiness: a worker can render",
+            description="200 while at least one render worker process has a working GL "
+                        "context, else 503: a readiness probe and the container's health "
+                        "check. Lists every worker with its pid, state, renders, memory, "
+                        "restarts and last error.",
+            responses={503: {"model": Readiness, "description": "No worker can render."}})
 async def readyz(svc: ServiceDep, response: Response) -> Readiness:
     workers = svc.pool.status()
-    ready = next((w for w in workers if w["state"] == "ready"), None)
+    ready = next((w for w in workers if w["state"] in ("ready", "busy")), None)
     response.status_code = 200 if ready else 503
     return Readiness(ready=ready is not None, backend=(ready or {}).get("backend"),
                      renderer=(ready or {}).get("renderer"), queue_depth=svc.pool.depth(),
-                     workers=workers)
+                     calibrated=svc.pool.cost.calibrated,
+                     memory_budget_bytes=memory_budget_bytes(svc.settings), workers=workers)
 
 
 @router.get("/metrics", tags=["operations"], summary="Prometheus metrics",
@@ -244,23 +99,16 @@ async def metrics_get(svc: ServiceDep) -> Response:
     return Response(svc.metrics.exposition(), media_type=Metrics.content_type)
 
 
-# The app
-
-
-def warmup_task() -> Task:
-    """Compile the default preset's shaders and load the CIE tables before the first request."""
+def warmup_task() -> ImageTask:
+    """Compile the default preset's shaders before the first request."""
     job = resolve(RenderRequest(width=16, height=16, quality="draft"))
-    draw = image_task(job, get_preset(job.preset))
-
-    def run(renderer: Any) -> bytes:
-        rgb_weights(int(TIERS["high"]["wavelengths"]))
-        return draw(renderer)
-
-    return run
+    return ImageTask(job, get_preset(job.preset))
 
 
 def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:
-    """The web page at '/' when service/web/ has one; otherwise '/' leads to the docs."""
+    """The web page at '/' when the web folder has one; otherwise '/' leads to the docs."""
+    from fastapi.staticfiles import StaticFiles
+
     index = web_dir / "index.html"
     if index.is_file():
         app.mount("/static", StaticFiles(directory=web_dir), name="static")
@@ -279,23 +127,38 @@ async def lifespan(app: FastAPI):
         await asyncio.to_thread(app.state.pool.stop)
 
 
-def create_app(settings: Settings | None = None,
-               renderer_factory: Callable[[], Any] | None = None) -> FastAPI:
+def renderer_for(settings: Settings) -> Any:
+    """The factory each worker process calls to make its renderer (picklable)."""
+    from opaline.gl.renderer import RenderBudgets, Renderer
+
+    mib = 1024 * 1024
+    budgets = RenderBudgets(max_programs=settings.worker_programs,
+                            scene_bytes=settings.worker_scene_mb * mib,
+                            target_bytes=settings.worker_target_mb * mib)
+    return partial(Renderer, settings.gl_backend, budgets=budgets)
+
+
+def create_app(settings: Settings | None = None, renderer_factory: Any = None) -> FastAPI:
     """The service; its lifespan starts the render workers and stops them at shutdown.
 
-    ``renderer_factory`` (called on each worker thread) defaults to a ``Renderer``
-    on ``settings.gl_backend``; tests pass one that fails on purpose.
+    ``renderer_factory`` (called in each worker process, so it must be picklable:
+    a module-level function or a partial of one) defaults to a ``Renderer`` on
+    ``settings.gl_backend``; tests pass one that fails on purpose.
     """
     if settings is None:
         settings = get_settings()
     metrics = Metrics()
     cache = ImageCache(settings.cache_bytes)
-    factory = renderer_factory or partial(Renderer, settings.gl_backend)
-    pool = WorkerPool(factory, workers=settings.workers,
-                      queue_size=settings.queue_size, deadline_s=settings.deadline_s,
-                      cache=cache, metrics=metrics,
-                      warmup=warmup_task() if settings.warmup else None)
+    lp_threads = settings.lp_threads or max(1, (os.cpu_count() or 1) // settings.workers)
+    pool = WorkerPool(
+        renderer_factory or renderer_for(settings), workers=settings.workers,
+        queue_size=settings.queue_size, deadline_s=settings.deadline_s,
+        render_timeout_s=settings.render_timeout_s, max_renders=settings.worker_max_renders,
+        max_rss_bytes=settings.worker_max_rss_mb * 1024 * 1024, lp_threads=lp_threads,
+        cache=cache, on_rendered=lambda label, s: metrics.render_seconds.labels(label).observe(s),
+        warmup=warmup_task() if settings.warmup else None, calibrate=settings.calibrate)
     metrics.watch(pool.depth, lambda: cache.size_bytes)
+    metrics.watch_pool(pool.counters, lambda: cache.evictions)
     app = FastAPI(title="Opaline", version=__version__, lifespan=lifespan,
                   description="Headless previews of iridescent materials "
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
@@ -303,6 +166,7 @@ def create_app(settings: Settings | None = None,
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
     install(app, settings.max_body_bytes, metrics)
+    app.include_router(render_router)
     app.include_router(router)
     mount_web(app)
     return app

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import hashlib
 import threading
-from collections import OrderedDict
 
+from opaline.lru import BudgetLRU
 from opaline.model.params import Material
 from opaline.model.request import content_key
 
@@ -22,8 +22,7 @@ class ImageCache:
 
     def __init__(self, budget_bytes: int) -> None:
         self.budget = budget_bytes
-        self._items: OrderedDict[str, bytes] = OrderedDict()
-        self._bytes = 0
+        self._items: BudgetLRU[str, bytes] = BudgetLRU(max_items=1 << 30, max_bytes=budget_bytes)
         self._lock = threading.Lock()
 
     def __len__(self) -> int:
@@ -31,27 +30,19 @@ class ImageCache:
 
     @property
     def size_bytes(self) -> int:
-        return self._bytes
+        return self._items.size_bytes
+
+    @property
+    def evictions(self) -> int:
+        return self._items.evictions
 
     def get(self, key: str) -> bytes | None:
         with self._lock:
-            data = self._items.get(key)
-            if data is not None:
-                self._items.move_to_end(key)
-            return data
+            return self._items.get(key)
 
     def put(self, key: str, data: bytes) -> None:
-        if len(data) > self.budget:
-            return
         with self._lock:
-            old = self._items.pop(key, None)
-            if old is not None:
-                self._bytes -= len(old)
-            self._items[key] = data
-            self._bytes += len(data)
-            while self._bytes > self.budget:
-                _, evicted = self._items.popitem(last=False)
-                self._bytes -= len(evicted)
+            self._items.put(key, data, len(data))
 
 
 def mdf_key(material: Material, size: int, fmt: str, wavelengths: int) -> str:

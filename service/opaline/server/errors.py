@@ -8,6 +8,7 @@ the body limit on an app.
 
 from __future__ import annotations
 
+import math
 from functools import partial
 from typing import Any
 
@@ -23,7 +24,14 @@ from opaline.model.presets import UnknownPreset
 from opaline.model.request import CostError
 from opaline.server.metrics import Metrics
 from opaline.server.queries import MdfQuery
-from opaline.server.worker import DeadlineExceeded, Overloaded, RenderFailed, Unavailable
+from opaline.workers.errors import (
+    Cancelled,
+    DeadlineExceeded,
+    Overloaded,
+    RenderFailed,
+    TooSlow,
+    Unavailable,
+)
 
 
 class LimitError(ValueError):
@@ -38,10 +46,12 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str | None]] = {
     UnknownPreset: (404, "unknown_preset"),
     CostError: (422, "cost"),
     LimitError: (422, "invalid"),
+    TooSlow: (422, "too_slow"),
     ValidationError: (422, "invalid"),
     Overloaded: (503, "queue_full"),
     DeadlineExceeded: (503, "deadline"),
     Unavailable: (503, "unavailable"),
+    Cancelled: (503, "cancelled"),
     RenderFailed: (500, None),
 }
 
@@ -108,7 +118,8 @@ async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
     if isinstance(exc, RenderFailed):
         return _problem(status, f"{exc}: the details are in the server log")
     if status == 503:
-        retry = str(state.settings.retry_after_s)
+        wait = getattr(exc, "retry_after_s", state.settings.retry_after_s)
+        retry = str(max(state.settings.retry_after_s, math.ceil(wait)))
         return _problem(status, f"{exc}; retry later", headers={"Retry-After": retry})
     return _problem(status, [str(exc)] if status == 422 else str(exc))
 

@@ -6,7 +6,7 @@ collide on counters.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Mapping
 
 from prometheus_client import (
     CONTENT_TYPE_LATEST,
@@ -16,13 +16,33 @@ from prometheus_client import (
     Histogram,
     generate_latest,
 )
+from prometheus_client.core import CounterMetricFamily
+from prometheus_client.registry import Collector
 
 # Render times on llvmpipe run from milliseconds (draft thumbnails) to tens of
 # seconds (reference tier at 2048²).
 RENDER_BUCKETS = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 30.0, 60.0)
 
-REJECT_REASONS = ("invalid", "unknown_preset", "cost", "too_large", "queue_full", "deadline",
-                  "unavailable")
+REJECT_REASONS = ("invalid", "unknown_preset", "cost", "too_slow", "too_large", "queue_full",
+                  "deadline", "unavailable", "cancelled")
+# The worker pool's own counters, exported as they stand at scrape time.
+POOL_COUNTERS = {
+    "restarts_crash": ("opaline_worker_restarts", "Worker processes replaced, by reason.",
+                       {"reason": "crash"}),
+    "restarts_died": ("opaline_worker_restarts", "", {"reason": "died"}),
+    "restarts_watchdog": ("opaline_worker_restarts", "", {"reason": "watchdog"}),
+    "recycles": ("opaline_worker_recycles", "Workers recycled after max renders or memory.", {}),
+    "watchdog_kills": ("opaline_watchdog_kills", "Renders killed past the time limit.", {}),
+    "program_evictions": ("opaline_worker_cache_evictions", "Worker cache evictions.",
+                          {"cache": "program"}),
+    "scene_evictions": ("opaline_worker_cache_evictions", "", {"cache": "scene"}),
+    "target_evictions": ("opaline_worker_cache_evictions", "", {"cache": "target"}),
+    "refused_too_slow": ("opaline_admission_refusals", "Jobs refused at admission, by reason.",
+                         {"reason": "too_slow"}),
+    "refused_queue": ("opaline_admission_refusals", "", {"reason": "queue"}),
+    "expired": ("opaline_jobs_expired", "Queued jobs dropped when their deadline passed.", {}),
+    "cancelled": ("opaline_jobs_cancelled", "Queued jobs dropped when every client left.", {}),
+}
 
 
 class Metrics:
@@ -63,8 +83,31 @@ class Metrics:
         self.queue_depth.set_function(queue_depth)
         self.cache_bytes.set_function(cache_bytes)
 
+    def watch_pool(self, counters: Mapping[str, int], image_evictions: Callable[[], int]) -> None:
+        """Export the pool's counters (a mapping it keeps up to date) and the image cache's
+        evictions at scrape time."""
+        self.registry.register(_PoolCollector(counters, image_evictions))
+
     def reject(self, reason: str) -> None:
         self.rejected.labels(reason).inc()
 
     def exposition(self) -> bytes:
         return generate_latest(self.registry)
+
+
+class _PoolCollector(Collector):
+    def __init__(self, counters: Mapping[str, int], image_evictions: Callable[[], int]) -> None:
+        self.counters, self.image_evictions = counters, image_evictions
+
+    def collect(self) -> Iterator[CounterMetricFamily]:
+        families: dict[str, CounterMetricFamily] = {}
+        for key, (name, doc, labels) in POOL_COUNTERS.items():
+            family = families.get(name)
+            if family is None:
+                family = families[name] = CounterMetricFamily(name, doc, labels=list(labels))
+            family.add_metric(list(labels.values()), self.counters.get(key, 0))
+        yield from families.values()
+        images = CounterMetricFamily("opaline_image_cache_evictions",
+                                     "Images evicted from the HTTP process's cache.")
+        images.add_metric([], self.image_evictions())
+        yield images

@@ -1,0 +1,44 @@
+"""The JSON answers of the non-image routes, as the OpenAPI document shows them."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, Field
+
+
+class PresetInfo(BaseModel):
+    """A preset as the API shows it."""
+
+    name: str
+    description: str
+    figure: str
+    geometry: dict[str, Any] = Field(description="Geometry generator and its arguments.")
+    tangents: str
+    normal_map: dict[str, Any] | None
+    defaults: dict[str, Any] = Field(description="The fields the preset sets itself.")
+    resolved: dict[str, Any] = Field(
+        description="What a request naming only this preset renders: every value resolved.")
+    key_light: dict[str, float] | None = Field(
+        None, description="Where the preset puts its key light, in degrees, as light_azimuth "
+        "and light_elevation measure them.")
+
+
+class Health(BaseModel):
+    status: str = Field(description="Always 'ok': the process and its event loop answer.")
+
+
+class Readiness(BaseModel):
+    """What /readyz answers, with 200 or 503 alike."""
+
+    ready: bool = Field(description="At least one worker process has a working GL context.")
+    backend: str | None = Field(description="GL backend of the first ready worker.")
+    renderer: str | None = Field(description="GL renderer string of the first ready worker.")
+    queue_depth: int = Field(description="Jobs waiting for a render worker.")
+    calibrated: bool = Field(description="Render times are predicted from this machine's "
+                                         "measured timings (else from conservative defaults).")
+    memory_budget_bytes: int = Field(
+        description="The most memory the service and its workers use together (settings).")
+    workers: list[dict[str, Any]] = Field(
+        description="Each worker process: name, state (starting, ready, busy, failed, stopped), "
+        "pid, renders, rss_bytes, restarts, its GL context's description, and the last error.")

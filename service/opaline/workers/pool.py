@@ -1,0 +1,294 @@
+"""The worker pool: a bounded queue in front of supervised worker processes.
+
+- admission: each job's time is predicted (``admission.CostModel``); a job
+  that alone would miss the deadline is refused (``TooSlow``, 422), and one
+  that would miss it behind the work already queued is refused too
+  (``Overloaded``, 503 with the predicted wait as Retry-After);
+- a deadline: a job still queued when its deadline passes leaves the queue at
+  once (the reaper), failing with ``DeadlineExceeded``;
+- single flight: a job whose key is queued or running gains a waiter;
+- cancellation: a job whose every waiter left is dropped from the queue, or
+  stopped between samples if it is running;
+- supervision, one ``Slot`` thread per process: watchdog, replacement, recycling.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import logging
+import math
+import threading
+import time
+import uuid
+from collections import Counter, deque
+from collections.abc import Awaitable, Callable
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from opaline.workers.admission import CostModel
+from opaline.workers.child import Reply
+from opaline.workers.errors import (
+    Cancelled,
+    DeadlineExceeded,
+    Overloaded,
+    RenderFailed,
+    TooSlow,
+    Unavailable,
+)
+from opaline.workers.slot import Slot
+from opaline.workers.tasks import CalibrateTask, Task
+
+log = logging.getLogger(__name__)
+REAP_S = 0.1
+
+
+class Store(Protocol):
+    def get(self, key: str) -> bytes | None: ...
+
+    def put(self, key: str, data: bytes) -> None: ...
+
+
+@dataclass(eq=False)
+class Job:
+    id: int
+    key: str
+    task: Task
+    label: str
+    deadline: float
+    predicted: float
+    future: Future = field(default_factory=Future)
+    waiters: int = 1
+    seconds: float = 0.0  # the worker's time for it, once done
+
+
+class WorkerPool:
+    """``workers`` processes behind a queue of ``queue_size`` jobs."""
+
+    def __init__(self, factory: Callable[[], Any], workers: int = 1, queue_size: int = 32,
+                 deadline_s: float = 10.0, render_timeout_s: float = 30.0,
+                 max_renders: int = 1000, max_rss_bytes: int = 1 << 30,
+                 lp_threads: int | None = None, cache: Store | None = None,
+                 on_rendered: Callable[[str, float], None] | None = None,
+                 warmup: Task | None = None, calibrate: bool = True,
+                 start_timeout_s: float = 60.0) -> None:
+        self.factory, self.size, self.queue_size = factory, workers, queue_size
+        self.deadline_s, self.render_timeout_s = deadline_s, render_timeout_s
+        self.max_renders, self.max_rss_bytes = max_renders, max_rss_bytes
+        self.lp_threads, self.cache, self.on_rendered = lp_threads, cache, on_rendered
+        self.warmup, self.calibrate, self.start_timeout_s = warmup, calibrate, start_timeout_s
+        self.cost = CostModel()
+        self.counters: Counter[str] = Counter()
+        self.stopping = True
+        self.slots: list[Slot] = []
+        self._queue: deque[Job] = deque()
+        self._inflight: dict[str, Job] = {}
+        self._ids = itertools.count(1)
+        self._cond = threading.Condition()
+        self._stop = threading.Event()
+        self._reaper: threading.Thread | None = None
+
+    # Lifecycle
+
+    def start(self, timeout: float | None = None) -> None:
+        """Start the workers and wait until each has a context (or failed to make one)."""
+        self.stopping = False
+        self._stop.clear()
+        self.slots = [Slot(self, i) for i in range(self.size)]
+        for slot in self.slots:
+            slot.thread.start()
+        end = time.monotonic() + (timeout or self.start_timeout_s)
+        for slot in self.slots:
+            slot.opened.wait(max(0.0, end - time.monotonic()))
+        self._reaper = threading.Thread(target=self._reap, name="opaline-reaper", daemon=True)
+        self._reaper.start()
+        if not self.ready:
+            log.error("no render worker has a GL context: %s",
+                      "; ".join(s.error or s.state for s in self.slots))
+            return
+        for name, task in (("warmup", self.warmup),
+                           ("calibration", CalibrateTask() if self.calibrate else None)):
+            if task is not None:
+                with self._cond:
+                    self._enqueue(Job(next(self._ids), f"{name}:{uuid.uuid4().hex}", task, name,
+                                      math.inf, 0.0))
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Refuse new jobs, fail the queued ones, and let each worker release its context."""
+        with self._cond:
+            self.stopping = True
+            self._stop.set()
+            queued, self._queue = list(self._queue), deque()
+            self._cond.notify_all()
+        for job in queued:
+            self.fail(job, Unavailable("the service is shutting down"))
+        end = time.monotonic() + timeout
+        for slot in self.slots:
+            slot.thread.join(max(0.0, end - time.monotonic()))
+            if slot.thread.is_alive():
+                log.warning("%s did not stop within %.0f s", slot.name, timeout)
+
+    def wait_stop(self, seconds: float) -> None:
+        self._stop.wait(seconds)
+
+    # Submitting
+
+    def submit(self, key: str, task: Task, label: str = "") -> Job:
+        """The job under ``key``: joined if in flight, else admitted and queued."""
+        with self._cond:
+            if self.stopping:
+                raise Unavailable("the render workers are not running")
+            found = self._inflight.get(key)
+            if found is not None:
+                found.waiters += 1
+                return found
+            job = Job(next(self._ids), key, task, label or task.label,
+                      time.monotonic() + self.deadline_s, self.cost.predict(*task.units()))
+            data = self.cache.get(key) if self.cache is not None else None
+            if data is not None:  # rendered after the caller looked
+                job.future.set_result(data)
+                return job
+            self._admit(job)
+            self._enqueue(job)
+            return job
+
+    def _admit(self, job: Job) -> None:
+        # A worker being replaced counts: its job waits the second a new process takes.
+        ready = sum(slot.state in ("ready", "busy", "starting") for slot in self.slots)
+        if not ready:
+            raise Unavailable("no render worker has a GL context (the server log says why)")
+        if job.predicted > self.deadline_s:
+            self.counters["refused_too_slow"] += 1
+            raise TooSlow(f"this request is predicted to take {job.predicted:.1f} s, over the "
+                          f"{self.deadline_s:g} s limit: lower width, height, samples or "
+                          "wavelengths (or choose a lower quality)")
+        now = time.monotonic()
+        running = sum(max(0.0, s.job.predicted - (now - s.job_started))
+                      for s in self.slots if s.job is not None)
+        backlog = (running + sum(j.predicted for j in self._queue)) / ready
+        if len(self._queue) >= self.queue_size or backlog + job.predicted > self.deadline_s:
+            self.counters["refused_queue"] += 1
+            raise Overloaded(f"{len(self._queue)} jobs are waiting, about {backlog:.1f} s of work",
+                             retry_after_s=max(1.0, backlog))
+
+    def _enqueue(self, job: Job) -> None:
+        self._queue.append(job)
+        self._inflight[job.key] = job
+        self._cond.notify()
+
+    async def render(self, key: str, task: Task, label: str = "", timeout: float | None = None,
+                     gone: Callable[[], Awaitable[Any]] | None = None) -> bytes:
+        """Submit and await; ``gone`` resolves when the client has left, which withdraws
+        this waiter (and drops the job if it was the last)."""
+        job = self.submit(key, task, label)
+        result = asyncio.ensure_future(asyncio.wrap_future(job.future))
+        watch = asyncio.ensure_future(gone()) if gone is not None else None
+        try:
+            waits = {result} | ({watch} if watch is not None else set())
+            done, _ = await asyncio.wait(waits, timeout=timeout,
+                                         return_when=asyncio.FIRST_COMPLETED)
+            if result in done:
+                return result.result()
+            if watch is not None and watch in done:
+                raise Cancelled("the client left")
+            raise DeadlineExceeded(f"no image within {timeout:g} s")
+        finally:
+            if watch is not None:
+                watch.cancel()
+            self.leave(job)
+
+    def leave(self, job: Job) -> None:
+        """One waiter is gone; the last one takes a queued job out of the queue."""
+        with self._cond:
+            job.waiters -= 1
+            if job.waiters > 0 or job.future.done():
+                return
+            if job in self._queue:
+                self._queue.remove(job)
+                self.counters["cancelled"] += 1
+            else:
+                return  # running: its slot sees waiters == 0 and stops it between samples
+        self.fail(job, Cancelled("every client waiting for it left"))
+
+    # Called by the slots
+
+    def take(self, slot: Slot) -> Job | None:
+        with self._cond:
+            if not self._queue:
+                self._cond.wait(0.2)
+            if not self._queue or self.stopping:
+                return None
+            return self._queue.popleft()
+
+    def finish(self, job: Job, reply: Reply) -> None:
+        job.seconds = reply.seconds
+        if reply.kind == "ok" and reply.data is not None:
+            if job.label == "calibration":
+                self.cost.calibrate(reply.data)
+            elif self.cache is not None:
+                self.cache.put(job.key, reply.data)
+            if self.on_rendered is not None:
+                self.on_rendered(job.label, reply.seconds)
+            self._settle(job, result=reply.data)
+        elif reply.kind == "cancelled":
+            self.fail(job, Cancelled(reply.error))
+        else:
+            incident = uuid.uuid4().hex[:12]
+            self.counters["render_failures"] += 1
+            log.error("render %s (%s) failed, incident %s:\n%s", job.key, job.label, incident,
+                      reply.error)
+            self.fail(job, RenderFailed(incident))
+
+    def fail(self, job: Job, exc: Exception) -> None:
+        self._settle(job, error=exc)
+
+    def _settle(self, job: Job, result: bytes | None = None,
+                error: Exception | None = None) -> None:
+        with self._cond:
+            if self._inflight.get(job.key) is job:
+                del self._inflight[job.key]
+        if job.future.done():
+            return
+        if error is not None:
+            job.future.set_exception(error)
+        else:
+            job.future.set_result(result)
+
+    def count_evictions(self, before: dict[str, int], after: dict[str, int]) -> None:
+        for name, value in after.items():
+            if name.endswith("_evictions"):
+                delta = value - before.get(name, 0)
+                self.counters[name] += delta if delta >= 0 else value  # a new worker counts from 0
+
+    def _reap(self) -> None:
+        """Fail queued jobs whose deadline has passed, so they free their place at once."""
+        while not self._stop.wait(REAP_S):
+            now = time.monotonic()
+            with self._cond:
+                expired = [job for job in self._queue if job.deadline < now]
+                for job in expired:
+                    self._queue.remove(job)
+            for job in expired:
+                self.counters["expired"] += 1
+                self.fail(job, DeadlineExceeded(f"queued longer than {self.deadline_s:g} s"))
+
+    # State
+
+    def depth(self) -> int:
+        return len(self._queue)
+
+    @property
+    def ready(self) -> bool:
+        return any(slot.ready for slot in self.slots)
+
+    @property
+    def identity(self) -> str:
+        """What draws the images, e.g. 'egl/llvmpipe (LLVM 15.0.6, 256 bits)/4.5 ...'."""
+        for slot in self.slots:
+            if slot.info:
+                return "/".join(slot.info.get(k, "") for k in ("backend", "renderer", "version"))
+        return ""
+
+    def status(self) -> list[dict[str, Any]]:
+        return [slot.status() for slot in self.slots]
