@@ -44,7 +44,7 @@ def shared_renderer(renderer, monkeypatch):
     from opaline.local import pipeline
 
     class Shared(pipeline.LocalRenderer):
-        def __init__(self, backend=None, cost_budget=pipeline.DEFAULT_COST_BUDGET):
+        def __init__(self, backend=None, cost_budget=None):
             self.renderer = renderer
             self.cost_budget = cost_budget
 

@@ -30,7 +30,7 @@ from opaline.batch.progress import PlainProgress, make_progress
 from opaline.batch.sheet import write_contact_sheet
 from opaline.model.materials import collect
 from opaline.output.files import write_atomic
-from opaline.settings import DEFAULT_COST_BUDGET
+from opaline.settings import get_settings
 
 
 @dataclass
@@ -56,7 +56,7 @@ def run_batch(inputs: list[str | Path], options: Options,
     started = time.monotonic()
     items = collect(inputs, options.overrides, exclude=[options.out, options.summary_path])
     # With --server the server checks the cost, against its own budget.
-    budget = None if options.server else DEFAULT_COST_BUDGET
+    budget = None if options.server else get_settings().cost_budget
     tasks = plan(items, options.out, force=options.force, cost_budget=budget)
     progress = progress or make_progress()
     progress.start(tasks)
