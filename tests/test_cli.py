@@ -34,26 +34,6 @@ def numbers_in(text: str) -> list[float]:
     return [float(n) * (math.pi if pi else 1.0) for n, pi in NUMBER.findall(text.replace("−", "-"))]
 
 
-@pytest.fixture
-def shared_renderer(renderer, monkeypatch):
-    """GL commands draw on the session's renderer instead of opening a context of their own.
-
-    A second context made and released on this thread would leave the session's OSMesa
-    context broken for every later GL test (see test_context's two-renderer test).
-    """
-    from opaline.local import pipeline
-
-    class Shared(pipeline.LocalRenderer):
-        def __init__(self, backend=None, cost_budget=None):
-            self.renderer = renderer
-            self.cost_budget = cost_budget
-
-        def close(self) -> None:  # the session owns the context
-            pass
-
-    monkeypatch.setattr(pipeline, "LocalRenderer", Shared)
-
-
 def run(capsys, *argv: str) -> tuple[int, str, str]:
     code = cli.main(list(argv))
     out, err = capsys.readouterr()
