@@ -384,6 +384,16 @@ def files_in(folder: Path) -> list[str]:
     return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*"))
 
 
+def test_unwritable_out_folder_is_one_line(tmp_path, backend, capsys):
+    """--out where nothing can be written: exit 1 and one line, never a traceback."""
+    folder = make_folder(tmp_path / "m", {"good.toml": CI_FILES["good.toml"]})
+    status, _, err = run_captured(capsys, "batch", str(folder), "--out", "/proc/opaline-thumbs",
+                                  "--backend", backend)
+    assert status == 1
+    assert err.strip().splitlines() == ["opaline batch: error: /proc/opaline-thumbs: "
+                                        "No such file or directory"]
+
+
 def test_quiet_batch_prints_only_failures(tmp_path, backend, capsys):
     """-q: no progress and no summary line; the failure lines stay on stderr."""
     folder = make_folder(tmp_path / "m", CI_FILES)

@@ -159,7 +159,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"opaline {args.command}: interrupted", file=sys.stderr)
         return 130
     except OSError as exc:  # a file or folder the command could not read or write
-        return fail(exc, 1)
+        where = exc.filename if exc.filename is not None else ""
+        return fail(f"{where}: {exc.strerror}" if where and exc.strerror else exc, 1)
     except Exception as exc:  # context or shader failures: one line, non-zero
         from opaline.gl.context import ContextError
         from opaline.gl.shaders import ShaderError
