@@ -394,8 +394,9 @@ def test_unwritable_out_folder_is_one_line(tmp_path, backend, capsys):
                                         "No such file or directory"]
 
 
-def test_quiet_batch_prints_only_failures(tmp_path, backend, capsys):
+def test_quiet_batch_prints_only_failures(tmp_path, backend, capsys, monkeypatch):
     """-q: no progress and no summary line; the failure lines stay on stderr."""
+    monkeypatch.delenv("GITHUB_ACTIONS", raising=False)  # annotations are failures: they stay
     folder = make_folder(tmp_path / "m", CI_FILES)
     status, out, err = run_captured(capsys, "-q", "batch", str(folder), "--out",
                                     str(tmp_path / "o"), "--backend", backend)
