@@ -49,3 +49,23 @@ def local(renderer):
     local.renderer = renderer
     local.cost_budget = 2048 * 2048 * 64 * 3
     return local
+
+
+@pytest.fixture
+def shared_renderer(renderer, monkeypatch):
+    """GL commands draw on the session's renderer instead of opening a context of their own.
+
+    A second context made and released on this thread would leave the session's OSMesa
+    context broken for every later GL test (see test_context's two-renderer test).
+    """
+    from opaline.local import pipeline
+
+    class Shared(pipeline.LocalRenderer):
+        def __init__(self, backend=None, cost_budget=None):
+            self.renderer = renderer
+            self.cost_budget = cost_budget
+
+        def close(self) -> None:  # the session owns the context
+            pass
+
+    monkeypatch.setattr(pipeline, "LocalRenderer", Shared)

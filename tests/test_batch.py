@@ -241,10 +241,12 @@ def test_rich_progress_reports_failures_and_finishes(tmp_path, backend):
                                           "bad-range.toml": MIXED["bad-range.toml"]})
     stream = io.StringIO()
     options = batch.Options(out=tmp_path / "out", backend=backend)
-    summary = batch.run_batch([folder], options, progress=progress.RichProgress(stream))
+    reporter = progress.RichProgress(stream, errors=stream)  # a terminal: both on stderr
+    summary = batch.run_batch([folder], options, progress=reporter)
     assert summary["counts"] == {"rendered": 1, "skipped": 0, "failed": 1}
     text = stream.getvalue()
-    assert "failed  bad-range" in text and "rendering" in text and "1/1" in text
+    assert "failed: " in text and "bad-range.toml:2: mu_f=5000" in text
+    assert "rendering" in text and "1/1" in text
 
 
 def test_plain_progress_lines_show_rate_and_eta(mixed, backend, capsys):
@@ -255,6 +257,151 @@ def test_plain_progress_lines_show_rate_and_eta(mixed, backend, capsys):
     text = capsys.readouterr().out
     assert "[1/3] rendered" in text and "/s, ETA" in text
     assert "3 rendered, 0 skipped, 3 failed" in text
+
+
+# In CI: failures on stderr, a JUnit report, GitHub annotations, pruning.
+
+TINY = 'width = 16\nheight = 16\nquality = "draft"\n'
+CI_FILES = {
+    "good.toml": 'preset = "cd-rom"\n' + TINY,
+    "typo.toml": 'preset = "cd-rom"\nmuf = 3\n' + TINY,
+    "sub/lost.json": '{\n  "preset": "no-such-preset",\n  "width": 16\n}\n',
+}
+
+
+def run_captured(capsys, *args: str) -> tuple[int, str, str]:
+    status = run_cli(*args)
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_failures_are_one_line_each_on_stderr_with_file_and_line(tmp_path, backend, capsys):
+    """Each failed material is one stderr line naming its file:line and the reason."""
+    folder = make_folder(tmp_path / "m", CI_FILES)
+    status, out, err = run_captured(capsys, "batch", str(folder), "--out", str(tmp_path / "o"),
+                                    "--backend", backend)
+    assert status == 1
+    failed = [line for line in err.splitlines() if line.startswith("failed: ")]
+    assert len(failed) == 2 and len(err.strip().splitlines()) == 2, err
+    assert any(f"{folder / 'typo.toml'}:2: muf: unknown field, did you mean mu_f?" in line
+               for line in failed), failed
+    assert any(f"{folder / 'sub/lost.json'}:2: preset='no-such-preset'" in line
+               for line in failed), failed
+    assert "failed:" not in out
+
+
+def test_junit_report_has_a_case_per_material(tmp_path, backend, capsys):
+    """--report junit FILE: well-formed XML, one testcase per material, failures with reasons."""
+    from xml.etree import ElementTree
+
+    folder = make_folder(tmp_path / "m", CI_FILES)
+    report = tmp_path / "reports" / "batch.xml"
+    status, _, _ = run_captured(capsys, "batch", str(folder), "--out", str(tmp_path / "o"),
+                                "--backend", backend, "--report", "junit", str(report))
+    assert status == 1
+    suite = ElementTree.parse(report).getroot().find("testsuite")
+    assert suite is not None and suite.get("tests") == "3" and suite.get("failures") == "2"
+    cases = {case.get("name"): case for case in suite.iter("testcase")}
+    assert set(cases) == {"good", "typo", "sub/lost"}
+    assert cases["good"].find("failure") is None
+    failure = cases["typo"].find("failure")
+    assert failure is not None and "did you mean mu_f?" in failure.get("message")
+    assert cases["typo"].get("file") == str(folder / "typo.toml")
+    assert cases["typo"].get("line") == "2"
+    assert "no-such-preset" in cases["sub/lost"].find("failure").get("message")
+
+
+def test_unknown_report_kind_is_a_usage_error(tmp_path, capsys):
+    status, _, err = run_captured(capsys, "batch", str(tmp_path), "--out", str(tmp_path / "o"),
+                                  "--report", "xunit", "r.xml")
+    assert status == 2 and "unknown report kind" in err
+
+
+@pytest.mark.parametrize("actions", ["true", None])
+def test_github_annotations_only_on_github_actions(tmp_path, backend, capsys, monkeypatch,
+                                                   actions):
+    """GITHUB_ACTIONS=true: an ::error annotation per failure, at its file and line."""
+    if actions:
+        monkeypatch.setenv("GITHUB_ACTIONS", actions)
+    else:
+        monkeypatch.delenv("GITHUB_ACTIONS", raising=False)
+    folder = make_folder(tmp_path / "m", CI_FILES)
+    _, out, _ = run_captured(capsys, "batch", str(folder), "--out", str(tmp_path / "o"),
+                             "--backend", backend)
+    annotations = [line for line in out.splitlines() if line.startswith("::error ")]
+    if not actions:
+        assert annotations == []
+        return
+    assert len(annotations) == 2
+    typo = next(a for a in annotations if "typo.toml" in a)
+    props, message = typo.removeprefix("::error ").split("::", 1)
+    assert props.startswith(f"file={folder / 'typo.toml'},line=2,title=")
+    assert "did you mean mu_f?" in message and "\n" not in message
+
+
+def test_no_material_found_is_a_usage_error(tmp_path, capsys):
+    """An input folder without material files exits 2 with one line, not "0 rendered"."""
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "empty" / "notes.txt").write_text("no materials here")
+    status, _, err = run_captured(capsys, "batch", str(tmp_path / "empty"), "--out",
+                                  str(tmp_path / "o"))
+    assert status == 2
+    assert len(err.strip().splitlines()) == 1 and "no material files" in err
+
+
+def test_empty_material_file_fails_instead_of_rendering_a_sphere(tmp_path, backend, capsys):
+    folder = make_folder(tmp_path / "m", {"empty.toml": ""})
+    status, _, err = run_captured(capsys, "batch", str(folder), "--out", str(tmp_path / "o"),
+                                  "--backend", backend)
+    assert status == 1 and "empty material file" in err
+    assert not (tmp_path / "o" / "empty.png").exists()
+
+
+def test_prune_removes_outputs_of_materials_that_are_gone(tmp_path, backend, capsys):
+    """--prune deletes the image and sidecar of a removed material, and nothing else."""
+    folder = make_folder(tmp_path / "m", {"a.toml": CI_FILES["good.toml"],
+                                          "sub/b.toml": CI_FILES["good.toml"],
+                                          "bad.toml": 'preset = "cd-rom"\nmu_f = -1\n'})
+    out = tmp_path / "o"
+    assert run_captured(capsys, "batch", str(folder), "--out", str(out), "--backend",
+                        backend)[0] == 1
+    (out / "mine.png").write_bytes(b"a user's file, no sidecar")
+    (folder / "sub" / "b.toml").unlink()
+    run_captured(capsys, "batch", str(folder), "--out", str(out), "--backend", backend)
+    assert (out / "sub" / "b.png").is_file(), "without --prune nothing is removed"
+    run_captured(capsys, "batch", str(folder / "typo"), "--out", str(out), "--prune",
+                 "--backend", backend)  # a missing input: no pruning at all
+    assert (out / "a.png").is_file() and (out / "sub" / "b.png").is_file()
+    status, _, _ = run_captured(capsys, "batch", str(folder), "--out", str(out), "--prune",
+                                "--backend", backend)
+    assert status == 1  # bad.toml still fails, and still exists: nothing of it is pruned
+    assert files_in(out) == ["a.png", "a.png.json", "mine.png", "summary.json"]
+    assert sorted(summary_of(out)["pruned"]) == [str(out / "sub/b.png"),
+                                                 str(out / "sub/b.png.json")]
+
+
+def files_in(folder: Path) -> list[str]:
+    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*"))
+
+
+def test_unwritable_out_folder_is_one_line(tmp_path, backend, capsys):
+    """--out where nothing can be written: exit 1 and one line, never a traceback."""
+    folder = make_folder(tmp_path / "m", {"good.toml": CI_FILES["good.toml"]})
+    status, _, err = run_captured(capsys, "batch", str(folder), "--out", "/proc/opaline-thumbs",
+                                  "--backend", backend)
+    assert status == 1
+    assert err.strip().splitlines() == ["opaline batch: error: /proc/opaline-thumbs: "
+                                        "No such file or directory"]
+
+
+def test_quiet_batch_prints_only_failures(tmp_path, backend, capsys, monkeypatch):
+    """-q: no progress and no summary line; the failure lines stay on stderr."""
+    monkeypatch.delenv("GITHUB_ACTIONS", raising=False)  # annotations are failures: they stay
+    folder = make_folder(tmp_path / "m", CI_FILES)
+    status, out, err = run_captured(capsys, "-q", "batch", str(folder), "--out",
+                                    str(tmp_path / "o"), "--backend", backend)
+    assert status == 1 and out == ""
+    assert len(err.strip().splitlines()) == 2 and err.startswith("failed: ")
 
 
 # Interrupts: a real process, a real signal.

@@ -51,18 +51,61 @@ def test_out_of_range_value_names_file_field_value_and_range(tmp_path):
 
 
 def test_unknown_field_is_rejected_with_the_known_ones(tmp_path):
-    """A misspelt field is an error that lists the real field names."""
+    """A misspelt field is an error that suggests the nearest field and lists the real ones."""
     path = write(tmp_path / "typo.toml", "muf = 3\n")
-    with pytest.raises(MaterialError, match=r"muf: unknown field \(known fields: .*mu_f"):
+    with pytest.raises(MaterialError, match=r"muf: unknown field, did you mean mu_f\? "
+                                            r"\(known fields: .*mu_f"):
         load_material(path)
 
 
-@pytest.mark.parametrize("name, text, kind", [("x.toml", "mu_f = = 3", "TOML"),
-                                              ("x.json", "{mu_f: 3", "JSON")])
-def test_syntax_error_names_the_file_and_format(tmp_path, name, text, kind):
-    """A file that is not valid TOML/JSON fails with its name and the parser's message."""
+def test_unknown_field_far_from_any_gets_no_suggestion(tmp_path):
+    """No "did you mean" when nothing is close: a wrong guess would mislead."""
+    path = write(tmp_path / "odd.toml", "zoom = 3\n")
+    with pytest.raises(MaterialError) as info:
+        load_material(path)
+    assert "zoom: unknown field (known fields:" in str(info.value)
+
+
+@pytest.mark.parametrize("name, text, line", [
+    ("hot.toml", '# a hot disc\npreset = "cd-rom"\n\nmu_f = 5000\n', 4),
+    ("hot.json", '{\n  "preset": "cd-rom",\n  "mu_f": 5000\n}\n', 3),
+    ("typo.toml", 'preset = "cd-rom"\nmuf = 3\n', 2),
+])
+def test_validation_error_names_the_line_of_its_key(tmp_path, name, text, line):
+    """A bad value is reported at file:line of its key, for editors and CI annotations."""
     path = write(tmp_path / name, text)
-    with pytest.raises(MaterialError, match=rf"{re.escape(str(path))}: invalid {kind}"):
+    with pytest.raises(MaterialError) as info:
+        load_material(path)
+    assert str(info.value).startswith(f"{path}:{line}: ")
+    assert info.value.line == line and info.value.path == str(path)
+
+
+def test_override_error_has_no_line_in_the_file(tmp_path):
+    """A bad value from the command line is not pinned on a line of the file."""
+    path = write(tmp_path / "disc.toml", 'preset = "cd-rom"\nmu_f = 3\n')
+    with pytest.raises(MaterialError) as info:
+        load_material(path, {"mu_f": 5000})
+    assert info.value.line is None and str(info.value).startswith(f"{path}: mu_f=5000")
+
+
+@pytest.mark.parametrize("name, text", [("empty.toml", ""), ("blank.toml", "# nothing\n"),
+                                        ("empty.json", "{}"),
+                                        ("schema-only.json", '{"$schema": "x.json"}')])
+def test_empty_material_file_is_an_error_not_the_default_sphere(tmp_path, name, text):
+    """An empty material file fails instead of silently rendering the default preset."""
+    path = write(tmp_path / name, text)
+    with pytest.raises(MaterialError, match="empty material file"):
+        load_material(path)
+    (item,) = collect([path])
+    assert item.request is None and "empty material file" in item.error
+
+
+@pytest.mark.parametrize("name, text, kind", [("x.toml", 'preset = "cd-rom"\nmu_f = = 3', "TOML"),
+                                              ("x.json", '{"preset": "cd-rom",\nmu_f: 3', "JSON")])
+def test_syntax_error_names_the_file_line_and_format(tmp_path, name, text, kind):
+    """A file that is not valid TOML/JSON fails with its name, line and the parser's message."""
+    path = write(tmp_path / name, text)
+    with pytest.raises(MaterialError, match=rf"{re.escape(str(path))}:2: invalid {kind}"):
         load_material(path)
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import os
 import subprocess
 import sys
 import threading
@@ -89,6 +90,73 @@ def test_render_of_a_material_file_path(on_thread, tmp_path):
     path = tmp_path / "disc.toml"
     path.write_text('preset = "cd-rom"\nmu_f = 6\nwidth = 64\nheight = 48\nquality = "draft"\n')
     assert on_thread(api_python.render, path) == on_thread(api_python.render, DISC)
+
+
+def test_render_of_a_material_file_given_as_str(on_thread, tmp_path):
+    """A str ending .json/.toml is a material file's path, read like a Path."""
+    path = tmp_path / "ball.json"
+    path.write_text('{"preset": "cd-rom", "mu_f": 6, "width": 64, "height": 48, '
+                    '"quality": "draft"}')
+    assert on_thread(api_python.render, str(path)) == on_thread(api_python.render, DISC)
+    with pytest.raises(api_python.RequestError, match="cannot read"):
+        on_thread(api_python.render, str(tmp_path / "missing.toml"))
+
+
+@pytest.fixture()
+def cost_budget(monkeypatch):
+    """Sets OPALINE_COST_BUDGET for one test (settings are read once, so the cache is reset)."""
+    from opaline.settings import get_settings
+
+    def set_budget(value: int) -> None:
+        monkeypatch.setenv("OPALINE_COST_BUDGET", str(value))
+        get_settings.cache_clear()
+
+    yield set_budget
+    monkeypatch.delenv("OPALINE_COST_BUDGET", raising=False)
+    get_settings.cache_clear()
+
+
+def test_cost_budget_comes_from_the_environment(on_thread, cost_budget):
+    """OPALINE_COST_BUDGET bounds the Python API as it bounds the HTTP service."""
+    from opaline.model.request import CostError
+
+    small = {**DISC, "width": 32, "height": 32}  # 32×32×1 sample×3 = 3072
+    cost_budget(3000)
+    with pytest.raises(CostError, match="over the budget of 3000"):
+        on_thread(api_python.render, small)
+    cost_budget(4000)
+    assert on_thread(api_python.render, small).startswith(b"\x89PNG")
+
+
+def test_plain_render_prints_no_third_party_warning():
+    """A spectral render without matplotlib (not a dependency) prints nothing on stderr, even
+    with every warning shown: colour-science's "Matplotlib ... not available" is silenced."""
+    code = ("import sys; sys.modules['matplotlib'] = None\n"  # as on a plain install
+            "from opaline import render\n"
+            "render({'preset': 'cd-rom', 'width': 16, 'height': 16, 'quality': 'draft', "
+            "'wavelengths': 3})\n")
+    result = subprocess.run([sys.executable, "-W", "default", "-c", code], cwd=ROOT,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+
+
+def test_public_api_is_typed_for_type_checkers(tmp_path):
+    """mypy sees render's real signature through `from opaline import render` (not Any)."""
+    pytest.importorskip("mypy")
+    use = tmp_path / "use.py"
+    use.write_text("from opaline import render, render_array\n"
+                   "data: bytes = render('ball.json')\n"
+                   "array = render_array({'preset': 'cd-rom'}, backend='osmesa')\n"
+                   "wrong: int = render({'preset': 'cd-rom'})\n"
+                   "render(42)\n")
+    result = subprocess.run(
+        [sys.executable, "-m", "mypy", "--no-incremental", "--follow-imports=silent",
+         "--no-error-summary", str(use)],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        env={**os.environ, "MYPYPATH": str(ROOT / "service")})
+    errors = [line for line in result.stdout.splitlines() if ": error:" in line]
+    assert [e.split(":")[1] for e in errors] == ["4", "5"], result.stdout
 
 
 def test_invalid_request_raises_with_field_value_and_range(on_thread):

@@ -4,11 +4,16 @@
 imported on first use so that importing the package stays light.
 """
 
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
 __all__ = ["__version__", "render", "render_array"]
 
+if TYPE_CHECKING:  # type checkers see the real signatures; at run time they load lazily
+    from opaline.local.api import render, render_array
 
-def __getattr__(name: str):
+
+def __getattr__(name: str) -> Any:
     if name in ("render", "render_array"):
         from opaline.local import api as api_python
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from opaline import __version__
+from opaline.model.material_file import at, locate
 from opaline.model.materials import Item
 from opaline.model.presets import UnknownPreset, get_preset
 from opaline.model.request import CostError, Job, check_cost, resolve
@@ -49,7 +50,7 @@ class Task:
         return {"name": self.item.name, "input": self.item.source,
                 "output": str(self.output) if self.written else None,
                 "status": self.status, "seconds": round(self.seconds, 4), "error": self.error,
-                "key": self.key}
+                "key": self.key, "file": self.item.file, "line": self.item.line}
 
 
 def plan(items: list[Item], out: Path, *, force: bool = False,
@@ -69,7 +70,9 @@ def plan_one(item: Item, out: Path, force: bool, cost_budget: int | None) -> Tas
         if cost_budget is not None:
             check_cost(task.job, cost_budget)
     except (UnknownPreset, CostError) as exc:
-        task.status, task.error = "failed", f"{item.source}: {exc}"
+        if isinstance(exc, UnknownPreset) and item.file == item.source:  # a material file
+            item.line = locate(item.file, "preset")
+        task.status, task.error = "failed", f"{at(item.source, item.line)}: {exc}"
         return task
     task.key = task.job.cache_key(preset.scene_key())
     task.output = out / (item.name + EXTENSIONS[task.job.format])
@@ -103,3 +106,38 @@ def remove_temporaries(tasks: list[Task], extra: list[Path]) -> None:
     for path in paths:
         for tmp in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
             tmp.unlink(missing_ok=True)
+
+
+def prune(out: Path, names: set[str]) -> list[Path]:
+    """Remove the outputs in ``out`` whose item is gone, with their sidecars; returns them.
+
+    Only pairs this batch wrote are touched: an image beside a sidecar holding a cache
+    key. ``names`` are every item's name, failed ones included (a material that now
+    fails still exists)."""
+    known = {name.lower() for name in names}
+    removed: list[Path] = []
+    for sidecar in sorted(out.rglob("*.json")):
+        image = sidecar.with_suffix("")  # NAME.png.json → NAME.png
+        if image.suffix not in EXTENSIONS.values() or not _is_sidecar(sidecar):
+            continue
+        if image.relative_to(out).with_suffix("").as_posix().lower() in known:
+            continue
+        for path in (image, sidecar):
+            if path.is_file():
+                path.unlink()
+                removed.append(path)
+        _remove_empty_parents(image.parent, out)
+    return removed
+
+
+def _is_sidecar(path: Path) -> bool:
+    try:
+        return "key" in json.loads(path.read_text())
+    except (OSError, ValueError, TypeError):
+        return False
+
+
+def _remove_empty_parents(folder: Path, out: Path) -> None:
+    while folder != out and folder.is_relative_to(out) and not any(folder.iterdir()):
+        folder.rmdir()
+        folder = folder.parent

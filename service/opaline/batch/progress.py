@@ -1,8 +1,10 @@
-"""Batch progress: a rich bar on a terminal, plain lines in logs and CI.
+"""Batch progress: a rich bar on a terminal, plain lines in logs and CI, or nothing (-q).
 
-Both report the same events: ``start`` with every planned task (the skipped
+All report the same events: ``start`` with every planned task (the skipped
 and the already failed are told at once), ``advance`` as each render ends,
-``close`` at the end or on an interrupt.
+``close`` at the end or on an interrupt. Each failure is also one line on
+stderr (``failed: FILE[:LINE]: why``), whatever the progress shows, so CI
+logs and ``2>`` catch them.
 """
 
 from __future__ import annotations
@@ -24,8 +26,9 @@ def use_rich(stream: Any, env: Any = os.environ) -> bool:
 class PlainProgress:
     """One line per finished item, with the rate and the time left."""
 
-    def __init__(self, stream: Any = None) -> None:
+    def __init__(self, stream: Any = None, errors: Any = None) -> None:
         self.stream = stream or sys.stdout
+        self.errors = errors or sys.stderr
         self.total = self.done = 0
         self.started = time.monotonic()
 
@@ -48,16 +51,24 @@ class PlainProgress:
         width = len(str(self.total))
         text = f"[{self.done:>{width}}/{self.total}] {task.status:<8} {task.item.name}"
         if task.status == "failed":
-            text += f": {task.error}"
+            self.failed(task)
         self.line(f"{text} ({task.seconds:.2f} s; {rate:.2f}/s, ETA {eta:.0f} s)")
 
     def failed(self, task: Task) -> None:
-        self.line(f"failed  {task.item.name}: {task.error}")
+        error = " ".join((task.error or "failed").split())  # a shader log has newlines
+        print(f"failed: {error}", file=self.errors, flush=True)
 
     def line(self, text: str) -> None:
         print(text, file=self.stream, flush=True)
 
     def close(self) -> None:
+        pass
+
+
+class QuietProgress(PlainProgress):
+    """-q: nothing but the failures (on stderr)."""
+
+    def line(self, text: str) -> None:
         pass
 
 
@@ -77,8 +88,14 @@ class RichProgress(PlainProgress):
             self.failed(task)
         self.bar.advance(self.bar_task)
 
+    def failed(self, task: Task) -> None:
+        if self.errors is self.stream:  # above the bar, not through it
+            self.line(f"failed: {' '.join((task.error or 'failed').split())}")
+        else:
+            super().failed(task)
+
     def line(self, text: str) -> None:
-        self.bar.console.print(text, markup=False, highlight=False)
+        self.bar.console.print(text, markup=False, highlight=False, soft_wrap=True)
 
     def close(self) -> None:
         self.bar.stop()
@@ -107,6 +124,9 @@ def _bar(console: Any) -> Any:
                     TimeRemainingColumn(), console=console)
 
 
-def make_progress() -> PlainProgress:
-    """The bar on stderr when it is a terminal (outside CI), else plain lines on stdout."""
+def make_progress(quiet: bool = False) -> PlainProgress:
+    """The bar on stderr when it is a terminal (outside CI), else plain lines on stdout;
+    with ``quiet`` only the failures."""
+    if quiet:
+        return QuietProgress(sys.stdout)
     return RichProgress(sys.stderr) if use_rich(sys.stderr) else PlainProgress(sys.stdout)

@@ -24,13 +24,17 @@ from pathlib import Path
 from typing import Any
 
 from opaline import __version__
-from opaline.batch.plan import Task, plan, remove_temporaries, write_result
+from opaline.batch.plan import Task, plan, prune, remove_temporaries, write_result
 from opaline.batch.pool import start_pool
 from opaline.batch.progress import PlainProgress, make_progress
 from opaline.batch.sheet import write_contact_sheet
-from opaline.model.materials import collect
+from opaline.model.materials import Item, collect
 from opaline.output.files import write_atomic
-from opaline.settings import DEFAULT_COST_BUDGET
+from opaline.settings import get_settings
+
+
+class NothingToRender(ValueError):
+    """The inputs hold no material file at all: a usage error, not an empty success."""
 
 
 @dataclass
@@ -44,6 +48,8 @@ class Options:
     summary: Path | None = None
     force: bool = False
     retries: int = 5
+    prune: bool = False  # remove outputs (with sidecars) whose material is gone
+    quiet: bool = False  # no progress lines; failures are still told on stderr
 
     @property
     def summary_path(self) -> Path:
@@ -55,10 +61,13 @@ def run_batch(inputs: list[str | Path], options: Options,
     """Render every input; returns the summary (also written to ``options.summary_path``)."""
     started = time.monotonic()
     items = collect(inputs, options.overrides, exclude=[options.out, options.summary_path])
+    if not items:
+        shown = ", ".join(map(str, inputs))
+        raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
     # With --server the server checks the cost, against its own budget.
-    budget = None if options.server else DEFAULT_COST_BUDGET
+    budget = None if options.server else get_settings().cost_budget
     tasks = plan(items, options.out, force=options.force, cost_budget=budget)
-    progress = progress or make_progress()
+    progress = progress or make_progress(options.quiet)
     progress.start(tasks)
     try:
         render_all(tasks, options, progress)
@@ -73,7 +82,8 @@ def run_batch(inputs: list[str | Path], options: Options,
             write_summary(tasks, options, started, interrupted=True)
         raise
     progress.close()
-    summary = write_summary(tasks, options, started, interrupted=False)
+    pruned = prune_outputs(inputs, items, options, progress)
+    summary = write_summary(tasks, options, started, interrupted=False, pruned=pruned)
     if options.sheet:
         write_contact_sheet(options.out, tasks)
     return summary
@@ -114,8 +124,26 @@ def finish(task: Task, future: Future) -> None:
     task.status = "rendered"
 
 
+def prune_outputs(inputs: list[str | Path], items: list[Item], options: Options,
+                  progress: PlainProgress) -> list[str] | None:
+    """--prune, unless an input is missing: a mistyped folder would otherwise look like
+    every material gone, and prune every thumbnail."""
+    if not options.prune:
+        return None
+    if not options.out.is_dir():
+        return []
+    missing = [str(p) for p in inputs if not Path(p).exists()]
+    if missing:
+        progress.line(f"not pruning: {', '.join(missing)} missing")
+        return []
+    removed = prune(options.out, {item.name for item in items})
+    if removed:
+        progress.line(f"pruned {len(removed)} file(s) of materials that are gone")
+    return [str(p) for p in removed]
+
+
 def write_summary(tasks: list[Task], options: Options, started: float,
-                  interrupted: bool) -> dict[str, Any]:
+                  interrupted: bool, pruned: list[str] | None = None) -> dict[str, Any]:
     counts = {s: sum(t.status == s for t in tasks) for s in ("rendered", "skipped", "failed")}
     if interrupted:
         counts["interrupted"] = sum(t.status == "interrupted" for t in tasks)
@@ -129,6 +157,8 @@ def write_summary(tasks: list[Task], options: Options, started: float,
         "counts": counts,
         "items": [t.record() for t in tasks],
     }
+    if pruned is not None:
+        summary["pruned"] = pruned
     text = json.dumps(summary, indent=2, ensure_ascii=False) + "\n"
     write_atomic(options.summary_path, text.encode())
     return summary
@@ -151,5 +181,3 @@ def _signals(handler: Any, *signals: signal.Signals) -> Iterator[None]:
 def _raise_interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
-
-# Command line.

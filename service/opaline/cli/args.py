@@ -1,23 +1,50 @@
-"""Argument helpers shared by the sub-commands: --set, --size, --backend, the one-line error."""
+"""Argument helpers shared by the sub-commands: --set, --size, --backend, the output file
+(its format from the extension, ``-`` for stdout) and the one-line error."""
 
 from __future__ import annotations
 
 import argparse
+import difflib
+import sys
+from pathlib import Path
+from typing import Any, get_args
 
 from pydantic import ValidationError
 
-from opaline.model.params import RenderRequest, describe_errors, field_range
+from opaline.model.material_file import MaterialError, load_material
+from opaline.model.params import (
+    ImageFormat,
+    Material,
+    MaterialFields,
+    RenderRequest,
+    describe_errors,
+    field_range,
+)
+from opaline.output.encode import EXTENSIONS
+from opaline.output.files import write_atomic
 from opaline.settings import BACKENDS
 
 TUPLE_FIELDS = {"albedo"}
+MATERIAL_SUFFIXES = (".toml", ".json")
+# What an extension may hold: the first is what the extension alone means.
+FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",)}
+STDOUT = "-"
 
 
 class CliError(Exception):
-    """A user error: printed as one line, exit status 2."""
+    """A user error: printed as one line, exit status ``status`` (2: usage)."""
+
+    status = 2
+
+
+class OutputError(CliError):
+    """The output cannot be written (permissions, no such folder, ...): exit status 1."""
+
+    status = 1
 
 
 def parameter_help() -> str:
-    lines = ["parameters for --set NAME=VALUE (unset ones come from the preset):"]
+    lines = ["parameters for --set NAME=VALUE (unset ones come from the preset or file):"]
     for name, info in RenderRequest.model_fields.items():
         if name == "preset":
             continue
@@ -30,8 +57,14 @@ def parameter_help() -> str:
     return "\n".join(lines)
 
 
-def parse_sets(pairs: list[str]) -> dict[str, object]:
-    values: dict[str, object] = {}
+def suggest(name: str, known: list[str] | tuple[str, ...]) -> str:
+    """", did you mean X?" for the nearest known name, or nothing when none is close."""
+    near = difflib.get_close_matches(name, known, n=1)
+    return f", did you mean {near[0]}?" if near else ""
+
+
+def parse_sets(pairs: list[str]) -> dict[str, Any]:
+    values: dict[str, Any] = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
         if not sep or not name:
@@ -50,19 +83,91 @@ def parse_size(text: str) -> tuple[int, int]:
         raise CliError(f"--size {text!r}: expected WxH or N, e.g. --size 512x256") from None
 
 
-def build_request(
-    preset: str, sets: list[str], size: str | None, fmt: str | None, extra: dict
-) -> RenderRequest:
-    fields = parse_sets(sets)
-    if size:
-        fields["width"], fields["height"] = parse_size(size)
-    if fmt:
-        fields["format"] = fmt
-    fields.update({k: v for k, v in extra.items() if v is not None})
+def load_request(source: str, fields: dict[str, Any]) -> RenderRequest:
+    """A preset name, or an existing material file (.toml/.json), with ``fields`` on top."""
+    if source.lower().endswith(MATERIAL_SUFFIXES):
+        if not Path(source).is_file():
+            raise CliError(f"{source}: no such material file")
+        try:
+            return load_material(source, fields)
+        except MaterialError as exc:
+            raise CliError(str(exc)) from None
     try:
-        return RenderRequest(preset=preset, **fields)
+        return RenderRequest(preset=source, **fields)
     except ValidationError as exc:
         raise CliError("; ".join(describe_errors(exc))) from None
+
+
+def output_format(output: str, wanted: str | None, own: str | None = None,
+                  allowed: tuple[str, ...] = get_args(ImageFormat)) -> str:
+    """The format to write ``output`` in: ``--format`` if given (it must fit a known
+    extension), else the request's ``own`` format if the extension fits it, else what
+    the extension means; png for stdout."""
+    if wanted is not None and wanted not in allowed:
+        raise CliError(f"format={wanted!r}: expected one of {', '.join(allowed)}")
+    fits = FORMATS_BY_SUFFIX.get(Path(output).suffix.lower()) if output != STDOUT else None
+    if wanted:
+        if fits and wanted not in fits:
+            raise CliError(f"--format {wanted} does not match -o {output}: {wanted} files end "
+                           f"in {EXTENSIONS[wanted]}")
+        return wanted
+    if output == STDOUT:
+        return own if own in allowed else "png"
+    if not fits:
+        raise CliError(f"-o {output}: cannot tell the format from the extension: "
+                       "use .png or .npy, or give --format")
+    return own if own in fits and own in allowed else fits[0]
+
+
+def write_output(output: str, data: bytes) -> None:
+    """Write the image to ``output`` whole (or not at all), or to stdout for ``-``."""
+    if output == STDOUT:
+        if sys.stdout.isatty():
+            raise CliError("-o -: refusing to write image data to a terminal; pipe it or "
+                           "redirect it to a file")
+        sys.stdout.flush()
+        sys.stdout.buffer.write(data)
+        sys.stdout.buffer.flush()
+        return
+    try:
+        write_atomic(Path(output), data)
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            raise
+        raise OutputError(f"cannot write {output}: {exc.strerror or exc}") from None
+
+
+PLOT_FIELDS = ("mdf", "ex", "ey", "mu_f", "alpha", "beta", "theta1", "theta2", "wavelengths")
+WAVELENGTHS_HELP = ("0 = the paper's RGB rotations (default), else 3 … 128 wavelengths "
+                    "integrated with CIE 1931.")
+
+
+def plot_parameter_help() -> str:
+    """The MDF plot's own parameter list: only what changes the plot, with its default."""
+    lines = ["plot parameters for --set NAME=VALUE (unset ones take the default shown):"]
+    for name in PLOT_FIELDS:
+        if name == "wavelengths":
+            lines.append(f"  {name:<12} {WAVELENGTHS_HELP}")
+            continue
+        desc = MaterialFields.model_fields[name].description or ""
+        lines.append(f"  {name:<12} {desc} Default {Material.model_fields[name].default}.")
+    return "\n".join(lines)
+
+
+def plot_fields(pairs: list[str]) -> dict[str, Any]:
+    """--set for the MDF plot: a field that does not change the plot is refused, not ignored."""
+    fields = parse_sets(pairs)
+    problems = []
+    for name in fields:
+        if name in PLOT_FIELDS:
+            continue
+        if name in RenderRequest.model_fields:
+            problems.append(f"--set {name}: does not affect the MDF plot")
+        else:
+            problems.append(f"--set {name}: unknown field{suggest(name, PLOT_FIELDS)}")
+    if problems:
+        raise CliError("; ".join(problems) + f" (plot parameters: {', '.join(PLOT_FIELDS)})")
+    return fields
 
 
 def add_common(parser: argparse.ArgumentParser) -> None:

@@ -3,27 +3,49 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 from pathlib import Path
 from typing import Any, get_args
 
 from pydantic import ValidationError
 
-from opaline.batch.run import Options, _raise_interrupt, _signals, run_batch
-from opaline.cli.args import CliError, add_common, parse_size
+from opaline.batch.report import github_annotations, junit_xml
+from opaline.batch.run import NothingToRender, Options, _raise_interrupt, _signals, run_batch
+from opaline.cli.args import CliError, add_common, parse_size, write_output
 from opaline.model.params import ImageFormat, Quality, RenderRequest, describe_errors
 
 
 def cmd_batch(args: argparse.Namespace) -> None:
     options = options_from_args(args)
+    report = report_path(args.report)
     with _signals(_raise_interrupt, signal.SIGTERM):  # SIGTERM stops a batch as Ctrl-C does
-        summary = run_batch(args.inputs, options)
+        try:
+            summary = run_batch(args.inputs, options)
+        except NothingToRender as exc:
+            raise CliError(str(exc)) from None
+    if report is not None:
+        write_output(str(report), junit_xml(summary))
+    if os.environ.get("GITHUB_ACTIONS") == "true":  # annotations on the failed files' lines
+        for line in github_annotations(summary):
+            print(line, flush=True)
     counts = summary["counts"]
-    print(f"opaline batch: {counts['rendered']} rendered, {counts['skipped']} skipped, "
-          f"{counts['failed']} failed in {summary['seconds']:.1f} s; "
-          f"summary: {options.summary_path}")
+    if not args.quiet:
+        print(f"opaline batch: {counts['rendered']} rendered, {counts['skipped']} skipped, "
+              f"{counts['failed']} failed in {summary['seconds']:.1f} s; "
+              f"summary: {options.summary_path}", flush=True)
     if counts["failed"]:
         raise SystemExit(1)
+
+
+def report_path(report: list[str] | None) -> Path | None:
+    """--report KIND FILE; JUnit XML is the kind every CI reads."""
+    if report is None:
+        return None
+    kind, path = report
+    if kind != "junit":
+        raise CliError(f"--report {kind}: unknown report kind (known: junit)")
+    return Path(path)
 
 
 def options_from_args(args: argparse.Namespace) -> Options:
@@ -40,7 +62,7 @@ def options_from_args(args: argparse.Namespace) -> Options:
     return Options(out=Path(args.out), jobs=jobs, overrides=overrides, server=args.server,
                    backend=args.backend, sheet=args.sheet,
                    summary=Path(args.summary) if args.summary else None, force=args.force,
-                   retries=args.retries)
+                   retries=args.retries, prune=args.prune, quiet=args.quiet)
 
 
 def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -63,8 +85,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "batch", help="render folders of material files or manifests to thumbnails",
         description="Render material files (TOML/JSON), folders of them (recursive) and "
-                    "manifests to DIR, skipping outputs that are up to date. Exit status 1 if "
-                    "any input failed (all others are still rendered), 130 if interrupted.")
+                    "manifests to DIR, skipping outputs that are up to date. Each failure is a "
+                    "line on stderr. Exit status 1 if any input failed (all others are still "
+                    "rendered), 2 for a usage error or no material file found, 130 if "
+                    "interrupted.")
     parser.add_argument("inputs", nargs="+", metavar="INPUT",
                         help="material file, folder of material files, or *.manifest.toml/json")
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
@@ -86,5 +110,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--summary", metavar="FILE",
                         help="machine-readable summary (default DIR/summary.json)")
     parser.add_argument("--force", action="store_true", help="render even if up to date")
+    parser.add_argument("--prune", action="store_true",
+                        help="remove images (and their .json sidecars) in DIR whose material "
+                             "is gone; only files a batch wrote are touched")
+    parser.add_argument("--report", nargs=2, metavar=("junit", "FILE"),
+                        help="also write a JUnit XML report to FILE, one test case per "
+                             "material (failures on the GitHub annotations too when "
+                             "GITHUB_ACTIONS=true)")
     add_common(parser)
     parser.set_defaults(func=cmd_batch)

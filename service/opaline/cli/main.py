@@ -1,59 +1,35 @@
-"""The ``opaline`` command: render presets, MDF plots, list presets, report the context."""
+"""The ``opaline`` command: the parser, the global options and the one-line errors.
+
+Sub-commands live beside it (render and mdf in ``render``, batch, gallery, serve,
+schema); ``presets`` and ``info`` are small enough to stay here. Every failure a
+user can cause or meet ends as one line on stderr, never a traceback: exit
+status 2 for a usage error, 1 for a failure of the machine or the output, 130
+for Ctrl-C, 141 when the reader of stdout went away (``| head``).
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import logging
+import os
+import signal
 import sys
 from pathlib import Path
-from typing import get_args
 
-from pydantic import ValidationError
-
-from opaline.cli import batch, gallery, schema, serve
-from opaline.cli.args import CliError, add_common, build_request, parameter_help, parse_sets
-from opaline.model.params import (
-    ImageFormat,
-    Material,
-    Quality,
-    RenderFields,
-    RenderRequest,
-    describe_errors,
-)
+from opaline import __version__
+from opaline.cli import batch, gallery, render, schema, serve
+from opaline.cli.args import CliError
+from opaline.model.material_file import MaterialError
+from opaline.model.params import RenderRequest
 from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
-from opaline.output.files import write_atomic
+from opaline.resources import PRESETS_ENV, presets_dir
 
-
-def cmd_render(args: argparse.Namespace) -> None:
-    from opaline.local.pipeline import LocalRenderer
-
-    request = build_request(
-        args.preset,
-        args.set,
-        args.size,
-        args.format,
-        {"quality": args.quality, "transparent": args.transparent or None},
-    )
-    with LocalRenderer(args.backend) as renderer:
-        data = renderer.render_bytes(request)
-    write_atomic(Path(args.output), data)
-
-
-def cmd_mdf(args: argparse.Namespace) -> None:
-    from opaline.local.pipeline import LocalRenderer
-
-    fields = parse_sets(args.set)
-    try:
-        wavelengths = RenderFields(wavelengths=fields.pop("wavelengths", 0)).wavelengths or 0
-        material = Material(**fields)
-    except ValidationError as exc:
-        raise CliError("; ".join(describe_errors(exc, RenderFields))) from None
-    if not 16 <= args.size <= 2048:
-        raise CliError(f"--size={args.size} is out of range: allowed [16 … 2048]")
-    with LocalRenderer(args.backend) as renderer:
-        data = renderer.mdf_bytes(material, args.size, args.format, wavelengths)
-    write_atomic(Path(args.output), data)
+log = logging.getLogger("opaline.cli")
+USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError)
+# Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
+USES_PRESETS = ("render", "presets", "batch", "gallery", "serve")
 
 
 def cmd_presets(args: argparse.Namespace) -> None:
@@ -89,106 +65,115 @@ def cmd_info(args: argparse.Namespace) -> None:
         print(f"{key}: {value}")
 
 
+def add_global(parser: argparse.ArgumentParser, presets: bool, top: bool = False) -> None:
+    """-q/-v (and --presets-dir) before or after the sub-command: a sub-command's copy has no
+    default, so it does not undo a value given before the sub-command."""
+    default = {} if top else {"default": argparse.SUPPRESS}
+    loudness = parser.add_mutually_exclusive_group()
+    loudness.add_argument("-q", "--quiet", action="store_true", **default,
+                          help="no progress or information on stderr; errors only")
+    loudness.add_argument("-v", "--verbose", action="store_true", **default,
+                          help="log what is done (resolved job, tier, timings) to stderr")
+    if presets:
+        parser.add_argument("--presets-dir", metavar="DIR", **({"default": None} | default),
+                            help=f"folder of scene presets (TOML) to use instead of the "
+                                 f"built-in ones (default ${PRESETS_ENV})")
+
+
 def make_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="opaline",
         description="Headless previews of iridescent materials (Kang, Lee, Cho 2014).",
     )
+    parser.add_argument("--version", action="version", version=f"opaline {__version__}")
+    add_global(parser, presets=True, top=True)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    fmt = argparse.RawDescriptionHelpFormatter
-    parameters = parameter_help()
-
-    render = sub.add_parser(
-        "render",
-        help="render a preset to an image file",
-        epilog=parameters,
-        formatter_class=fmt,
-    )
-    render.add_argument("preset", help="preset name (see `opaline presets`)")
-    render.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="override a parameter; repeatable (albedo takes R,G,B)",
-    )
-    render.add_argument(
-        "--size", metavar="WxH", help="image size, each 16 … 2048 (default 256x256)"
-    )
-    render.add_argument(
-        "--format", choices=get_args(ImageFormat), help="output format (default png)"
-    )
-    render.add_argument(
-        "--quality", choices=get_args(Quality), help="quality tier (default standard)"
-    )
-    render.add_argument("--transparent", action="store_true", help="transparent PNG background")
-    render.add_argument("-o", "--output", required=True, help="output file")
-    add_common(render)
-    render.set_defaults(func=cmd_render)
-
-    mdf = sub.add_parser(
-        "mdf",
-        help="plot the MDF over the half-vector disc (Figs. 2, 3, 6, 7)",
-        epilog=parameters,
-        formatter_class=fmt,
-    )
-    mdf.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="NAME=VALUE",
-        help="material parameter; repeatable (mdf, ex, ey, mu_f, alpha, beta, theta1, "
-        "theta2, wavelengths)",
-    )
-    mdf.add_argument("--size", type=int, default=256, help="plot size N (N×N), 16 … 2048")
-    mdf.add_argument(
-        "--format",
-        choices=["png", "npy"],
-        default="png",
-        help="png (normalised, sRGB) or npy (linear D, float32)",
-    )
-    mdf.add_argument("-o", "--output", required=True, help="output file")
-    add_common(mdf)
-    mdf.set_defaults(func=cmd_mdf)
+    render.register(sub)
 
     presets = sub.add_parser("presets", help="list presets with their descriptions and defaults")
     presets.add_argument("--json", action="store_true", help="full preset data as JSON")
     presets.set_defaults(func=cmd_presets)
 
     info = sub.add_parser("info", help="report the GL backend and renderer Opaline gets")
-    add_common(info)
+    render.add_common(info)
     info.set_defaults(func=cmd_info)
 
     for module in (gallery, serve, batch, schema):
         module.register(sub)
+    for name, command in sub.choices.items():
+        add_global(command, presets=name in USES_PRESETS)
     return parser
 
 
+def use_presets_dir(folder: str | None) -> None:
+    """--presets-dir: the same as $OPALINE_PRESETS_DIR, set before any preset is loaded."""
+    if folder is None:
+        return
+    if not Path(folder).expanduser().is_dir():
+        raise CliError(f"--presets-dir {folder}: no such folder")
+    os.environ[PRESETS_ENV] = folder  # read by resources.presets_dir, here and in workers
+    all_presets.cache_clear()
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = make_parser()
-    args = parser.parse_args(argv)
+    args = make_parser().parse_args(argv)
+    logger = logging.getLogger("opaline")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter(f"opaline {args.command}: %(message)s"))
+    saved = logger.level, logger.propagate
+    level = logging.ERROR if args.quiet else logging.INFO if args.verbose else logging.WARNING
+    logger.setLevel(level)
+    logger.propagate = args.command == "serve"  # serve logs through the root, beside uvicorn
+    if not logger.propagate:
+        logger.addHandler(handler)
     try:
+        return run(args)
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(saved[0])
+        logger.propagate = saved[1]
+
+
+def run(args: argparse.Namespace) -> int:
+    def fail(message: object, status: int) -> int:
+        print(f"opaline {args.command}: error: {message}", file=sys.stderr)
+        return status
+
+    try:
+        use_presets_dir(getattr(args, "presets_dir", None))
+        if args.command in USES_PRESETS:
+            log.info("presets from %s", presets_dir())
         args.func(args)
-    except (CliError, PresetError, UnknownPreset, CostError) as exc:
-        print(f"opaline {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        sys.stdout.flush()  # a closed pipe shows here, inside the handler below
+    except BrokenPipeError:
+        # The reader went away (`| head`): as the Python docs advise, point stdout at
+        # devnull so the flush at exit does not fail again, and exit as SIGPIPE would.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 128 + signal.SIGPIPE
+    except CliError as exc:
+        return fail(exc, exc.status)
+    except USAGE_ERRORS as exc:
+        return fail(exc, 2)
     except KeyboardInterrupt:
         print(f"opaline {args.command}: interrupted", file=sys.stderr)
         return 130
+    except OSError as exc:  # a file or folder the command could not read or write
+        where = exc.filename if exc.filename is not None else ""
+        return fail(f"{where}: {exc.strerror}" if where and exc.strerror else exc, 1)
     except Exception as exc:  # context or shader failures: one line, non-zero
         from opaline.gl.context import ContextError
         from opaline.gl.shaders import ShaderError
 
         if isinstance(exc, (ContextError, ShaderError)):
-            print(f"opaline {args.command}: error: {exc}", file=sys.stderr)
-            return 1
+            return fail(exc, 1)
         raise
     return 0
 
 
 if __name__ == "__main__":
     # Run the imported module's main, not this __main__ copy: sub-command modules raise
-    # service.cli.CliError, which a second copy of the class would not catch.
+    # opaline.cli.args.CliError, which a second copy of the class would not catch.
     from opaline.cli.main import main as _main
 
     sys.exit(_main())

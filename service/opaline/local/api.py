@@ -1,4 +1,4 @@
-"""``from service import render``: one call, a request in, image bytes out (docs/python.md).
+"""``from opaline import render``: one call, a request in, image bytes out (docs/python.md).
 
     from opaline import render
     from opaline import render_array
@@ -14,18 +14,24 @@ releases the calling thread's renderer. Invalid requests raise ``RequestError``
 
 from __future__ import annotations
 
+import os
 import threading
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from pydantic import ValidationError
 
 from opaline.local.pipeline import LocalRenderer
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.request import Job
+from opaline.settings import BackendName
 
-RequestLike = RenderRequest | dict[str, Any] | Path
+# A request model, its fields as a mapping, or the path of a material file (.toml/.json).
+RequestLike = RenderRequest | Mapping[str, Any] | str | os.PathLike[str]
+MATERIAL_SUFFIXES = (".toml", ".json")
 
 
 class RequestError(ValueError):
@@ -40,25 +46,32 @@ _local = threading.local()
 
 
 def as_request(request: RequestLike) -> RenderRequest:
-    """A RenderRequest from a model, a dict of its fields, or a material file path."""
+    """A RenderRequest from a model, a mapping of its fields, or a material file's path.
+
+    A ``str`` is a path only when it ends in .toml or .json: a bare name such as
+    ``"cd-rom"`` is refused rather than guessed to be a preset or a file."""
     if isinstance(request, RenderRequest):
         return request
-    if isinstance(request, Path):
+    if isinstance(request, str) and not request.lower().endswith(MATERIAL_SUFFIXES):
+        raise TypeError(f"render({request!r}): a str must be a material file's path "
+                        f"(.toml or .json); for a preset pass {{'preset': {request!r}}}")
+    if isinstance(request, str | os.PathLike):
         from opaline.model.materials import MaterialError, load_material
 
         try:
-            return load_material(request)
+            return load_material(Path(request))
         except MaterialError as exc:
             raise RequestError([str(exc)]) from None
-    if not isinstance(request, dict):
-        raise TypeError(f"expected a RenderRequest, a dict or a Path, got {type(request).__name__}")
+    if not isinstance(request, Mapping):
+        raise TypeError("expected a RenderRequest, a mapping, or a material file's path, "
+                        f"got {type(request).__name__}")
     try:
-        return RenderRequest.model_validate(request)
+        return RenderRequest.model_validate(dict(request))
     except ValidationError as exc:
         raise RequestError(describe_errors(exc)) from None
 
 
-def renderer(backend: str | None = None) -> LocalRenderer:
+def renderer(backend: BackendName | None = None) -> LocalRenderer:
     """This thread's renderer, created on first use (or anew for a different ``backend``:
     one context per thread, and EGL and OSMesa should not share a process anyway)."""
     found: LocalRenderer | None = getattr(_local, "renderer", None)
@@ -71,17 +84,19 @@ def renderer(backend: str | None = None) -> LocalRenderer:
     return found
 
 
-def render(request: RequestLike, *, backend: str | None = None) -> bytes:
+def render(request: RequestLike, *, backend: BackendName | None = None) -> bytes:
     """Encoded image bytes (PNG, 16-bit PNG or .npy, as the request's ``format`` says)."""
     return renderer(backend).render_bytes(as_request(request))
 
 
-def render_array(request: RequestLike, *, backend: str | None = None) -> np.ndarray:
+def render_array(
+    request: RequestLike, *, backend: BackendName | None = None
+) -> npt.NDArray[np.float32]:
     """Linear, premultiplied RGBA float32 of shape (height, width, 4)."""
     return renderer(backend).render_array(as_request(request))
 
 
-def render_job(job: Job, *, backend: str | None = None) -> bytes:
+def render_job(job: Job, *, backend: BackendName | None = None) -> bytes:
     """Encoded bytes for a job already resolved (``request.resolve``), as in ``opaline batch``."""
     return renderer(backend).render_job(job)
 

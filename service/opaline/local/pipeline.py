@@ -16,9 +16,9 @@ import numpy as np
 from opaline.gl.renderer import Renderer
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import get_preset
-from opaline.model.request import Job, check_cost, resolve
+from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import encode_frame, encode_mdf
-from opaline.settings import DEFAULT_COST_BUDGET
+from opaline.settings import get_settings
 
 
 @dataclass
@@ -31,9 +31,13 @@ class Rendered:
 class LocalRenderer:
     """Renders requests on a private headless context."""
 
-    def __init__(self, backend: str | None = None, cost_budget: int = DEFAULT_COST_BUDGET) -> None:
+    def __init__(self, backend: str | None = None, cost_budget: int | None = None) -> None:
         self.renderer = Renderer(backend)
-        self.cost_budget = cost_budget
+        self.cost_budget = cost_budget  # None: OPALINE_COST_BUDGET, as in the HTTP service
+
+    @property
+    def budget(self) -> int:
+        return get_settings().cost_budget if self.cost_budget is None else self.cost_budget
 
     def __enter__(self) -> LocalRenderer:
         return self
@@ -46,7 +50,7 @@ class LocalRenderer:
 
     def job(self, request: RenderRequest) -> Job:
         job = resolve(request, get_preset(request.preset))
-        check_cost(job, self.cost_budget)
+        check_cost(job, self.budget)
         return job
 
     def render_job(self, job: Job) -> bytes:
@@ -59,9 +63,12 @@ class LocalRenderer:
     def render_array(self, request: RenderRequest) -> np.ndarray:
         """Linear, premultiplied RGBA float32 (H, W, 4)."""
         job = replace(self.job(request), format="npy")
-        return self.renderer.render(job).linear
+        linear = self.renderer.render(job).linear
+        assert linear is not None  # an npy job always reads back linear radiance
+        return linear
 
     def mdf_plot(self, material: Material, size: int, wavelengths: int = 0) -> np.ndarray:
+        check_plot_cost(size, wavelengths, self.budget)
         return self.renderer.mdf_plot(material, size, wavelengths)
 
     def mdf_bytes(

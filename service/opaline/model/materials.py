@@ -17,21 +17,25 @@ with an ``error``, so a batch can render every other input.
 
 from __future__ import annotations
 
-import json
 import re
-import tomllib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pydantic import ValidationError
+from opaline.model.material_file import (
+    SCHEMA_KEY,
+    SUFFIXES,
+    MaterialError,
+    load_material,
+    parse_request,
+    read_table,
+)
+from opaline.model.params import RenderRequest
 
-from opaline.model.params import RenderRequest, describe_errors
+__all__ = ["Item", "MaterialError", "collect", "load_material", "material_schema"]
 
-SUFFIXES = (".toml", ".json")
 MANIFEST_SUFFIXES = (".manifest.toml", ".manifest.json")
-SCHEMA_KEY = "$schema"  # allowed in files so editors can find the schema; ignored
 # An output name: every segment starts with a letter or digit, so no "..", no hidden
 # file and no absolute path can escape the output folder.
 NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*(/[A-Za-z0-9][A-Za-z0-9._-]*)*$")
@@ -39,62 +43,34 @@ MANIFEST_KEYS = {"defaults", "material"}
 ENTRY_KEYS = {"name", "path"}
 
 
-class MaterialError(ValueError):
-    """A material file or manifest is unreadable or invalid; the message names the file."""
-
-
 @dataclass
 class Item:
-    """One thing to render: a stable output name, where it came from, and the request or why not."""
+    """One thing to render: a stable output name, where it came from, and the request or why not.
+
+    ``file`` and ``line`` locate a failure for CI annotations (line None when unknown)."""
 
     name: str
     source: str
     request: RenderRequest | None = None
     error: str | None = None
+    file: str | None = None
+    line: int | None = None
 
 
 def is_manifest(path: Path) -> bool:
     return path.name.lower().endswith(MANIFEST_SUFFIXES)
 
 
-def read_table(path: Path) -> dict[str, Any]:
-    """The top-level table of a TOML or JSON file."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MaterialError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    is_json = path.suffix.lower() == ".json"
-    try:
-        data = json.loads(text) if is_json else tomllib.loads(text)
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise MaterialError(f"{path}: invalid {'JSON' if is_json else 'TOML'}: {exc}") from None
-    if not isinstance(data, dict):
-        raise MaterialError(f"{path}: expected a table of fields, got {type(data).__name__}")
-    data.pop(SCHEMA_KEY, None)
-    return data
-
-
-def parse_request(fields: dict[str, Any], where: str) -> RenderRequest:
-    """Validate fields with the request model; errors name ``where``, the field and the range."""
-    try:
-        return RenderRequest.model_validate(fields)
-    except ValidationError as exc:
-        raise MaterialError(f"{where}: " + "; ".join(describe_errors(exc))) from None
-
-
-def load_material(path: Path | str, overrides: dict[str, Any] | None = None) -> RenderRequest:
-    """Parse one material file; ``overrides`` win over the file's fields."""
-    path = Path(path)
-    fields = read_table(path)
-    fields.update(overrides or {})
-    return parse_request(fields, str(path))
+def failed(name: str, source: str, exc: MaterialError, file: Path | str) -> Item:
+    """An item for a MaterialError, keeping its file and line."""
+    return Item(name, source, error=str(exc), file=exc.path or str(file), line=exc.line)
 
 
 def material_items(path: Path, name: str, overrides: dict[str, Any]) -> list[Item]:
     try:
-        return [Item(name, str(path), load_material(path, overrides))]
+        return [Item(name, str(path), load_material(path, overrides), file=str(path))]
     except MaterialError as exc:
-        return [Item(name, str(path), error=str(exc))]
+        return [failed(name, str(path), exc, path)]
 
 
 def manifest_items(path: Path, prefix: str, overrides: dict[str, Any]) -> list[Item]:
@@ -103,7 +79,7 @@ def manifest_items(path: Path, prefix: str, overrides: dict[str, Any]) -> list[I
         data = read_table(path)
         entries, defaults = _manifest_parts(path, data)
     except MaterialError as exc:
-        return [Item(prefix + path.name.split(".")[0], str(path), error=str(exc))]
+        return [failed(prefix + path.name.split(".")[0], str(path), exc, path)]
     return [_entry_item(path, index, entry, defaults, prefix, overrides)
             for index, entry in enumerate(entries)]
 
@@ -126,7 +102,8 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict, prefix: 
                 overrides: dict[str, Any]) -> Item:
     where = f"{manifest}[material {index + 1}]"
     if not isinstance(entry, dict):
-        return Item(f"{prefix}#{index + 1}", where, error=f"{where}: expected a table")
+        return Item(f"{prefix}#{index + 1}", where, error=f"{where}: expected a table",
+                    file=str(manifest))
     fields = {k: v for k, v in entry.items() if k not in ENTRY_KEYS}
     ref = entry.get("path")
     name = entry.get("name")
@@ -135,21 +112,26 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict, prefix: 
     if not isinstance(name, str) or not NAME_RE.match(name):
         shown = f"#{index + 1}" if name is None else str(name)
         return Item(prefix + shown, where, error=f"{where}: name={name!r} must be letters, digits, "
-                    "'.', '_', '-' and '/' separators (a relative output name)")
+                    "'.', '_', '-' and '/' separators (a relative output name)",
+                    file=str(manifest))
     where = f"{manifest}[{name}]"
     try:
         merged = dict(defaults)
         if ref is not None:
             if not isinstance(ref, str):
                 raise MaterialError(f"{where}: path={ref!r} must be a string")
-            merged.update(read_table(manifest.parent / ref))
+            table = read_table(manifest.parent / ref)
+            if not table:
+                raise MaterialError(f"{where}: {ref} is an empty material file",
+                                    manifest.parent / ref)
+            merged.update(table)
             where = f"{manifest}[{name}] ({ref})"
         merged.update(fields)
         merged.update(overrides)
         request = parse_request(merged, where)
     except MaterialError as exc:
-        return Item(prefix + name, where, error=str(exc))
-    return Item(prefix + name, where, request)
+        return failed(prefix + name, where, exc, manifest)
+    return Item(prefix + name, where, request, file=str(manifest))
 
 
 def scan_folder(folder: Path, exclude: Iterable[Path] = ()) -> list[Path]:
@@ -187,7 +169,7 @@ def collect(inputs: list[str | Path], overrides: dict[str, Any] | None = None,
             items.extend(_file_items(path, Path(path.name), overrides))
         else:
             items.append(Item(path.stem or str(path), str(path),
-                              error=f"{path}: no such file or folder"))
+                              error=f"{path}: no such file or folder", file=str(path)))
     return _unique(items)
 
 
@@ -195,7 +177,7 @@ def _file_items(path: Path, rel: Path, overrides: dict[str, Any]) -> list[Item]:
     """The items of one file; ``rel`` is its path below the input folder (or its bare name)."""
     name = rel.with_suffix("").as_posix()
     if path.suffix.lower() not in SUFFIXES:
-        return [Item(name, str(path),
+        return [Item(name, str(path), file=str(path),
                      error=f"{path}: expected a .toml or .json material file or manifest")]
     if is_manifest(path):
         prefix = "" if rel.parent == Path(".") else rel.parent.as_posix() + "/"

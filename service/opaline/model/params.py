@@ -6,6 +6,7 @@ files and material files all read these models, so a range is written once.
 
 from __future__ import annotations
 
+import difflib
 import math
 from typing import Annotated, Any, Literal
 
@@ -245,8 +246,10 @@ def describe_errors(
         allowed = field_range(owner, name)
         kind = err["type"]
         if kind == "extra_forbidden":
-            known = ", ".join(sorted(owner.model_fields))
-            lines.append(f"{where}: unknown field (known fields: {known})")
+            known = sorted(owner.model_fields)
+            near = difflib.get_close_matches(name, known, n=1)  # "muf" → mu_f
+            hint = f", did you mean {near[0]}?" if near else ""
+            lines.append(f"{where}: unknown field{hint} (known fields: {', '.join(known)})")
         elif kind == "missing" and isinstance(err["loc"][-1], int):
             lines.append(f"{name}: expected {_tuple_length(owner, name)} values, got fewer")
         elif kind == "missing":

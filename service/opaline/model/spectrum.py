@@ -9,7 +9,9 @@ flat spectrum (equal D everywhere) gives equal R, G, B.
 
 from __future__ import annotations
 
+import warnings
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -34,11 +36,22 @@ def rotation_at(wavelengths: np.ndarray, theta1: float, theta2: float) -> np.nda
     return np.where(lam < xs[0], below, np.where(lam > xs[2], above, inside))
 
 
+def _import_colour() -> Any:
+    """colour-science, imported late: it is slow to import and only spectral renders need it.
+
+    Without matplotlib (not a dependency: Opaline uses none of colour's plotting) its import
+    warns that the plotting API is unavailable; only that warning is silenced."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings(
+            "ignore", message='"Matplotlib" related API features are not available')
+        import colour
+    return colour
+
+
 @lru_cache(maxsize=32)
 def rgb_weights(count: int) -> np.ndarray:
     """(count, 3) weights from per-wavelength D to linear sRGB; columns sum to 1."""
-    import colour  # imported late: it is slow to import and only spectral renders need it
-
+    colour = _import_colour()
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     lam = sample_wavelengths(count)
     xyz = np.array([cmfs[w] for w in lam])  # (count, 3), interpolated by colour-science
