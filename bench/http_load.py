@@ -9,7 +9,8 @@ nothing else is contacted), waits for /readyz, and measures at 256²:
 - misses: distinct parameters (a render each), one client, then several at once;
 - hits: one cached image asked for again and again, several clients at once;
 - hits under load: cached images asked for while distinct renders run, which
-  shows how much a render holds up the event loop (moderngl keeps the GIL).
+  shows how much rendering holds up the event loop (renders run in worker
+  processes, so only the CPU is shared).
 
 Every phase is bounded in request count and in time; the server is stopped
 at the end whatever happens.
@@ -41,7 +42,7 @@ PHASE_LIMIT_S = 120.0  # no phase runs longer than this
 def local_service(workers: int, queue_size: int) -> LocalServer:
     """The service with a queue deep enough for the whole run and a generous deadline."""
     return LocalServer(workers, env={"OPALINE_QUEUE_SIZE": str(queue_size),
-                                     "OPALINE_DEADLINE_S": "120"})
+                                     "OPALINE_DEADLINE_S": "120", "OPALINE_CALIBRATE": "0"})
 
 
 def percentile(values: list[float], q: float) -> float:

@@ -15,7 +15,8 @@ from functools import partial
 from typing import TYPE_CHECKING
 
 from opaline.workers.errors import RenderFailed
-from opaline.workers.pool import Job, WorkerPool
+from opaline.workers.job import Job
+from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import ImageTask
 
 if TYPE_CHECKING:

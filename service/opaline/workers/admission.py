@@ -15,7 +15,10 @@ from __future__ import annotations
 
 import json
 import threading
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+
+from opaline.workers.errors import Overloaded, TooSlow, Unavailable
 
 # Before calibration: about 4× the slowest preset measured on a 2-core llvmpipe machine
 # (oil-slick, 256² draft: 25 ms for 65,536 pixel-samples), and 5% more per wavelength.
@@ -71,3 +74,22 @@ class CostModel:
             return {"calibrated": self.calibrated, "overhead_s": round(self.overhead_s, 5),
                     "labels": {k: {"per_unit_s": c.per_unit_s, "per_wavelength": c.per_wavelength}
                                for k, c in self.labels.items()}}
+
+
+def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequence[float],
+          queue_size: int, deadline_s: float) -> Exception | None:
+    """Why a job predicted to take ``predicted`` seconds cannot be taken now, or None.
+
+    ``running``: the predicted seconds left of each job being rendered; ``queued``:
+    the predictions of the jobs waiting. The work ahead is shared by the workers."""
+    if not workers:
+        return Unavailable("no render worker has a GL context (the server log says why)")
+    if predicted > deadline_s:
+        return TooSlow(f"this request is predicted to take {predicted:.1f} s, over the "
+                       f"{deadline_s:g} s limit: lower width, height, samples or wavelengths "
+                       "(or choose a lower quality)")
+    backlog = (sum(running) + sum(queued)) / workers
+    if len(queued) >= queue_size or backlog + predicted > deadline_s:
+        return Overloaded(f"{len(queued)} jobs are waiting, about {backlog:.1f} s of work",
+                          retry_after_s=max(1.0, backlog))
+    return None

@@ -23,44 +23,23 @@ import time
 import uuid
 from collections import Counter, deque
 from collections.abc import Awaitable, Callable
-from concurrent.futures import Future
-from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
-from opaline.workers.admission import CostModel
+from opaline.workers.admission import CostModel, admit
 from opaline.workers.child import Reply
 from opaline.workers.errors import (
     Cancelled,
     DeadlineExceeded,
-    Overloaded,
     RenderFailed,
     TooSlow,
     Unavailable,
 )
+from opaline.workers.job import Job, Store
 from opaline.workers.slot import Slot
 from opaline.workers.tasks import CalibrateTask, Task
 
 log = logging.getLogger(__name__)
 REAP_S = 0.1
-
-
-class Store(Protocol):
-    def get(self, key: str) -> bytes | None: ...
-
-    def put(self, key: str, data: bytes) -> None: ...
-
-
-@dataclass(eq=False)
-class Job:
-    id: int
-    key: str
-    task: Task
-    label: str
-    deadline: float
-    predicted: float
-    future: Future = field(default_factory=Future)
-    waiters: int = 1
-    seconds: float = 0.0  # the worker's time for it, once done
 
 
 class WorkerPool:
@@ -154,23 +133,17 @@ class WorkerPool:
             return job
 
     def _admit(self, job: Job) -> None:
-        # A worker being replaced counts: its job waits the second a new process takes.
-        ready = sum(slot.state in ("ready", "busy", "starting") for slot in self.slots)
-        if not ready:
-            raise Unavailable("no render worker has a GL context (the server log says why)")
-        if job.predicted > self.deadline_s:
-            self.counters["refused_too_slow"] += 1
-            raise TooSlow(f"this request is predicted to take {job.predicted:.1f} s, over the "
-                          f"{self.deadline_s:g} s limit: lower width, height, samples or "
-                          "wavelengths (or choose a lower quality)")
         now = time.monotonic()
-        running = sum(max(0.0, s.job.predicted - (now - s.job_started))
-                      for s in self.slots if s.job is not None)
-        backlog = (running + sum(j.predicted for j in self._queue)) / ready
-        if len(self._queue) >= self.queue_size or backlog + job.predicted > self.deadline_s:
-            self.counters["refused_queue"] += 1
-            raise Overloaded(f"{len(self._queue)} jobs are waiting, about {backlog:.1f} s of work",
-                             retry_after_s=max(1.0, backlog))
+        running = [max(0.0, s.job.predicted - (now - s.job_started))
+                   for s in self.slots if s.job is not None]
+        # A worker being replaced counts: its job waits the second a new process takes.
+        workers = sum(slot.state in ("ready", "busy", "starting") for slot in self.slots)
+        refusal = admit(job.predicted, workers, running, [j.predicted for j in self._queue],
+                        self.queue_size, self.deadline_s)
+        if refusal is not None:
+            self.counters["refused_too_slow" if isinstance(refusal, TooSlow)
+                          else "refused_queue"] += 1
+            raise refusal
 
     def _enqueue(self, job: Job) -> None:
         self._queue.append(job)
@@ -254,12 +227,6 @@ class WorkerPool:
             job.future.set_exception(error)
         else:
             job.future.set_result(result)
-
-    def count_evictions(self, before: dict[str, int], after: dict[str, int]) -> None:
-        for name, value in after.items():
-            if name.endswith("_evictions"):
-                delta = value - before.get(name, 0)
-                self.counters[name] += delta if delta >= 0 else value  # a new worker counts from 0
 
     def _reap(self) -> None:
         """Fail queued jobs whose deadline has passed, so they free their place at once."""

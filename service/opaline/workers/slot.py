@@ -21,7 +21,8 @@ from opaline.workers import child
 from opaline.workers.errors import DeadlineExceeded, Unavailable
 
 if TYPE_CHECKING:
-    from opaline.workers.pool import Job, WorkerPool
+    from opaline.workers.job import Job
+    from opaline.workers.pool import WorkerPool
 
 log = logging.getLogger(__name__)
 SPAWN = multiprocessing.get_context("spawn")
@@ -116,8 +117,7 @@ class Slot:
         self.renders += 1
         self.total_renders += 1
         self.rss_bytes = reply.rss_bytes
-        self.pool.count_evictions(self._stats, reply.stats)
-        self._stats = reply.stats
+        self.count_evictions(reply.stats)
         self.pool.finish(job, reply)
         if reply.kind == "crash":
             self.replace("crash")
@@ -126,6 +126,15 @@ class Slot:
                      reply.rss_bytes >> 20)
             self.pool.counters["recycles"] += 1
             self.shutdown()
+
+    def count_evictions(self, stats: dict[str, int]) -> None:
+        """Add what the worker's caches evicted since its last reply (a new worker counts
+        from 0 again)."""
+        for name, value in stats.items():
+            if name.endswith("_evictions"):
+                delta = value - self._stats.get(name, 0)
+                self.pool.counters[name] += delta if delta >= 0 else value
+        self._stats = stats
 
     def await_reply(self, job: Job) -> child.Reply | None:
         limit = self.job_started + self.pool.render_timeout_s
