@@ -16,7 +16,7 @@ from opaline.model.request import resolve
 
 
 def test_worker_processes_are_spawned_not_forked():
-    """--jobs N > 1 uses the spawn start method (a context made before a fork hangs, DESIGN §8)."""
+    """--jobs N > 1 uses the spawn start method (a context made before a fork hangs, docs/design.md §10)."""
     pool = start_pool(jobs=2)
     try:
         assert pool.executor._mp_context.get_start_method() == "spawn"

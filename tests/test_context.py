@@ -1,4 +1,4 @@
-"""Headless GL contexts (service/context.py, service/osmesa.py): choice, fallback, agreement."""
+"""Headless GL contexts (opaline.gl.context, opaline.gl.osmesa): choice, fallback, agreement."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Stability at the extremes (issue 4; DESIGN.md §3 ranges, §6 degenerate geometry).
+"""Stability at the extremes (issue 4; docs/design.md §5 ranges, §8 degenerate geometry).
 
 For every end of every parameter range (``stability_cases.EXTREMES``, ids name
 the extreme: ``ex=1e6``, ``theta1=-2pi``, ``mu_f=0`` ...):
@@ -226,7 +226,7 @@ def test_probe_agrees_property_multipeak(renderer, mat, seed):
     check_probe(renderer.probe(mat, n, t, l, v), ref.reflected_radiance(mat, n, t, l, v))
 
 
-# -- degenerate geometry (DESIGN §6), case by case ------------------------------------
+# -- degenerate geometry (docs/design.md §8), case by case ------------------------------------
 
 DEGENERATE_MATERIALS = {
     "multipeak": material(MULTIPEAK, kd=0.2),
