@@ -150,8 +150,11 @@ def test_fresh_venv_install_runs_every_entry_point(wheel, tmp_path):
     small = ("--size", "64x64", "--quality", "draft")
     run(opaline, "render", "cd-rom", "-o", "out.png", *small)
     assert (work / "out.png").read_bytes().startswith(PNG_MAGIC)
-    if "stdout" in run(opaline, "render", "--help").stdout.decode():
-        assert run(opaline, "render", "cd-rom", "-o", "-", *small).stdout.startswith(PNG_MAGIC)
+    # `-o -` means standard output where the CLI supports it; an older CLI writes a
+    # file named "-" instead, which is not a failure of the install.
+    to_stdout = run(opaline, "render", "cd-rom", "-o", "-", *small)
+    if not (work / "-").exists():
+        assert to_stdout.stdout.startswith(PNG_MAGIC)
 
     (work / "disc.toml").write_text('preset = "cd-rom"\nmu_f = 6\nwidth = 64\nheight = 64\n'
                                     'quality = "draft"\n')

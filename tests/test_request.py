@@ -131,7 +131,8 @@ def test_cache_key_stable_across_processes():
     code = ("from opaline.model.params import RenderRequest; from opaline.model.presets import get_preset; "
             "from opaline.model.request import resolve; p = get_preset('cd-rom'); "
             "print(resolve(RenderRequest(preset='cd-rom', mu_f=3.0), p).cache_key(p.scene_key()))")
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONHASHSEED": "12345"}
+    # The checkout's package (service/): an installed opaline hashes other shader sources.
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "service"), "PYTHONHASHSEED": "12345"}
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
                          text=True, check=True, timeout=60)
     assert out.stdout.strip() == key("cd-rom", mu_f=3.0)
