@@ -3,7 +3,7 @@
 #   docker build -t opaline .
 #   docker run --rm -p 8000:8000 opaline            # docs at http://localhost:8000/docs
 #
-# Settings come from OPALINE_* variables (service/settings.py), e.g.
+# Settings come from OPALINE_* variables (service/opaline/settings.py), e.g.
 #   docker run -e OPALINE_QUEUE_SIZE=64 -e OPALINE_GL_BACKEND=osmesa ...
 
 # Stage 1: build the wheel (shaders and presets ship inside it as package data).

@@ -1,4 +1,4 @@
-"""The speed/accuracy trade, measured (DESIGN §6): every preset at every tier.
+"""The speed/accuracy trade, measured (docs/design.md §8): every preset at every tier.
 
     python bench/accuracy.py [--size 256] [--presets cd-rom ...] [--quick] [--images DIR]
 

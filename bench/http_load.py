@@ -177,7 +177,7 @@ def reading(summary: list[dict]) -> list[str]:
     if best == counts[0]:
         lines.append(
             "- Why more workers do not help: llvmpipe already spreads each draw over every core "
-            "(DESIGN §8), and moderngl holds the GIL through each GL call, so a second worker "
+            "(docs/design.md §10), and moderngl holds the GIL through each GL call, so a second worker "
             "thread cannot overlap its draws with the first and keeps the event loop waiting "
             "more of the time.")
     return lines

@@ -1,8 +1,8 @@
-"""Inputs and checks for ``tests/test_stability.py`` (issue 4, DESIGN.md §3 and §6).
+"""Inputs and checks for ``tests/test_stability.py`` (issue 4, docs/design.md §5 and §8).
 
-- ``EXTREMES``: one material per end of every range of DESIGN §3, each named
+- ``EXTREMES``: one material per end of every range of docs/design.md §5, each named
   (``ex=1e6``, ``theta1=-2pi``, ``mu_f=0`` ...);
-- ``DEGENERATE``: the degenerate geometry of DESIGN §6 as named (n, t, l, v)
+- ``DEGENERATE``: the degenerate geometry of docs/design.md §8 as named (n, t, l, v)
   cases;
 - ``random_cases`` / ``lobe_cases``: generic shading cases, the second aimed at
   the specular lobe at every width from 1e-4 to 1 (so that exponents up to 1e6
@@ -184,7 +184,7 @@ def _perp(a, scale):
     return list(np.asarray(a) + scale * p)
 
 
-# name -> (n, t, l, v). DESIGN §6: grazing light and view, l = -v, h along n,
+# name -> (n, t, l, v). docs/design.md §8: grazing light and view, l = -v, h along n,
 # tangents parallel to the normal (sphere poles), zero tangents, near-coincident l, v.
 DEGENERATE: dict[str, tuple[list[float], list[float], list[float], list[float]]] = {
     # Grazing light: n·l exactly 0, tiny, and slightly below the horizon.

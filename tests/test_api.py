@@ -192,7 +192,7 @@ def test_preset_detail(client):
 
 
 def test_root_serves_the_web_page_or_the_docs(client):
-    """/ serves service/web/index.html when the package has it, else redirects to /docs."""
+    """/ serves opaline/server/web/index.html when the package has it, else redirects to /docs."""
     response = client.get("/", follow_redirects=False)
     if (WEB_DIR / "index.html").is_file():
         assert response.status_code == 200 and "text/html" in response.headers["content-type"]

@@ -19,7 +19,7 @@ from opaline.workers.slot import SPAWN
 
 @pytest.mark.gl
 def test_worker_processes_are_spawned_not_forked(backend):
-    """Local workers are spawned (a context made before a fork hangs), not threads of ours."""
+    """Local workers are spawned (a context made before a fork hangs, docs/design.md §10), not threads of ours."""
     pool = start_pool(jobs=2, backend=backend)
     try:
         assert SPAWN.get_start_method() == "spawn"

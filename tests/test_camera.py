@@ -1,4 +1,4 @@
-"""Camera and key-light placement (service/camera.py): the override keeps distance and centre."""
+"""Camera and key-light placement (opaline.gl.camera): the override keeps distance and centre."""
 
 from __future__ import annotations
 

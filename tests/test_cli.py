@@ -1,4 +1,4 @@
-"""The `opaline` command (service/cli.py), run in-process through main()."""
+"""The `opaline` command (opaline.cli), run in-process through main()."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from opaline.output import files
 
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere")
-# DESIGN §3 ranges (and exposure, light angles), written out independently of params.py.
+# docs/design.md §5 ranges (and exposure, light angles), written out independently of params.py.
 RANGES = {
     "ex": (0, 1e6), "ey": (0, 1e6), "mu_f": (0, 1000), "alpha": (0, 1000), "beta": (0, 1000),
     "theta1": (-2 * math.pi, 2 * math.pi), "theta2": (-2 * math.pi, 2 * math.pi),

@@ -1,4 +1,4 @@
-"""Headless GL contexts (service/context.py, service/osmesa.py): choice, fallback, agreement."""
+"""Headless GL contexts (opaline.gl.context, opaline.gl.osmesa): choice, fallback, agreement."""
 
 from __future__ import annotations
 
@@ -32,7 +32,8 @@ HIDE_OSMESA = textwrap.dedent("""
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
-    environment = {**os.environ, "PYTHONPATH": str(ROOT)}
+    # The checkout's package (service/), not whichever opaline the venv has installed.
+    environment = {**os.environ, "PYTHONPATH": str(ROOT / "service")}
     return subprocess.run([sys.executable, *args], cwd=ROOT, env=environment,
                           capture_output=True, text=True, timeout=120)
 

@@ -1,4 +1,4 @@
-"""Encoders (service/encode.py): exact PNGs, 16-bit PNGs built by hand, .npy, MDF display."""
+"""Encoders (opaline.output.encode): exact PNGs, 16-bit PNGs built by hand, .npy, MDF display."""
 
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ FIGURE_MATERIALS = [
 
 
 def random_material(rng: np.random.Generator) -> Material:
-    """A material drawn across the full ranges of DESIGN §3 (exponents log-uniform)."""
+    """A material drawn across the full ranges of docs/design.md §5 (exponents log-uniform)."""
     return Material(
         mdf=str(rng.choice(["ashikhmin", "multipeak"])),
         ex=float(10 ** rng.uniform(-3, 6)),
@@ -86,7 +86,7 @@ def test_mdf_plot_layout_is_the_paper_convention(renderer):
 def shading_cases(rng, count):
     """Random frames with l and v in the upper hemisphere of n, plus degenerate cases."""
     n, t, l, v = random_cases(rng, count)
-    # Degenerate geometry (DESIGN §6): l = -v, h exactly along n, t parallel to n, grazing.
+    # Degenerate geometry (docs/design.md §8): l = -v, h exactly along n, t parallel to n, grazing.
     n[:4] = [0.0, 0.0, 1.0]
     t[:4] = [[1, 0, 0], [0, 0, 1], [1, 0, 0], [1, 0, 0]]
     l[:4] = [[0, 0, 1], [0, 0, 1], [1, 0, 0], [0.6, 0, 0.8]]

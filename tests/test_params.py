@@ -1,4 +1,4 @@
-"""Request parameters (service/params.py): DESIGN §3's ranges, enforced and explained."""
+"""Request parameters (opaline.model.params): docs/design.md §5's ranges, enforced and explained."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from pydantic import ValidationError
 from opaline.model.params import Material, RenderRequest, describe_errors
 
 TAU = 2 * math.pi
-# DESIGN §3 (plus exposure and the light angles), written out independently.
+# docs/design.md §5 (plus exposure and the light angles), written out independently.
 FLOATS = {
     "ex": (0.0, 1e6), "ey": (0.0, 1e6),
     "mu_f": (0.0, 1000.0), "alpha": (0.0, 1000.0), "beta": (0.0, 1000.0),

@@ -1,4 +1,4 @@
-"""Scene presets (service/presets.py): the files load, match the paper, and fail clearly."""
+"""Scene presets (opaline.model.presets): the files load, match the paper, and fail clearly."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from opaline.model.presets import (
 )
 from opaline.model.request import resolve
 
-# DESIGN.md §4, written out independently of the preset files.
+# docs/design.md §6, written out independently of the preset files.
 PAPER = {
     "cd-rom": dict(mdf="multipeak", mu_f=8.5, alpha=2.0, beta=1.2, theta1=0.1, theta2=0.2),
     "cd-rom-wide": dict(mdf="multipeak", mu_f=2.5, alpha=1.0, beta=5.0, theta1=0.1, theta2=0.2),
@@ -29,7 +29,7 @@ PAPER = {
     "oil-slick": dict(mdf="multipeak", mu_f=10.0, alpha=20.0, beta=1.0, theta1=0.1, theta2=0.2),
     "oil-slick-soft": dict(mdf="multipeak", mu_f=3.0, alpha=2.0, beta=1.0,
                            theta1=math.pi / 6, theta2=math.pi / 3),
-    # "defaults above": DESIGN §3's defaults.
+    # docs/design.md §5's defaults.
     "sphere": dict(mdf="multipeak", mu_f=8.5, alpha=2.0, beta=1.2, theta1=0.1, theta2=0.2),
 }
 CD_ROMS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin")
@@ -83,14 +83,14 @@ def test_every_file_loads():
 
 
 def test_preset_names_are_the_eight_of_design():
-    """The presets are exactly the eight of DESIGN §4."""
+    """The presets are exactly the eight of docs/design.md §6."""
     assert set(all_presets()) == set(PAPER)
     assert len(all_presets()) == 8
 
 
 @pytest.mark.parametrize("name", sorted(PAPER))
 def test_material_matches_the_paper(name):
-    """The preset's resolved material has the paper's figure parameters (DESIGN §4)."""
+    """The preset's resolved material has the paper's figure parameters (docs/design.md §6)."""
     material = resolve(RenderRequest(preset=name)).material
     for field, value in PAPER[name].items():
         got = getattr(material, field)

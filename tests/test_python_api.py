@@ -1,4 +1,4 @@
-"""`from service import render`: a request in, the same bytes as every other path out."""
+"""`from opaline import render`: a request in, the same bytes as every other path out."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""More samples, more wavelengths and the analytic filter each buy accuracy (DESIGN §6).
+"""More samples, more wavelengths and the analytic filter each buy accuracy (docs/design.md §8).
 
 On cd-rom (mu_f 8.5: rings a few pixels wide at 128²), each knob is turned
 while the others stay fixed, and the error against a brute-force image of the

@@ -1,4 +1,4 @@
-"""Invariants of the float64 NumPy reference (service/reference.py), pbrt style."""
+"""Invariants of the float64 NumPy reference (opaline.model.reference), pbrt style."""
 
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def test_rotate_half_composes(hx, hy, a, b):
 
 
 def test_rotate_half_is_counter_clockwise():
-    """A quarter turn takes +x to +y (counter-clockwise, DESIGN §1)."""
+    """A quarter turn takes +x to +y (counter-clockwise, docs/design.md §1.2)."""
     rx, ry = ref.rotate_half(1.0, 0.0, math.pi / 2)
     assert (rx, ry) == pytest.approx((0.0, 1.0), abs=1e-15)
 
@@ -144,7 +144,7 @@ def test_ashikhmin_finite_at_the_rim_exactly(s2, exponent):
 
 
 def test_ashikhmin_near_pole_at_high_exponent_is_accurate():
-    """Near the pole with ex = 1e6 the MDF matches exp(ex·½·log1p(−s²)) (DESIGN §8)."""
+    """Near the pole with ex = 1e6 the MDF matches exp(ex·½·log1p(−s²)) (docs/design.md §2)."""
     hx, ex = 1e-3, 1e6
     s2 = hx * hx
     expected = math.sqrt((ex + 1) * (1 + 1)) / (2 * math.pi) * math.exp(0.5 * ex * math.log1p(-s2))

@@ -1,4 +1,4 @@
-"""Request resolution (service/request.py): merge order, tiers, cost, cache keys."""
+"""Request resolution (opaline.model.request): merge order, tiers, cost, cache keys."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ def custom_preset(**defaults):
 
 
 def test_builtin_defaults_fill_everything():
-    """With empty preset defaults and an empty request, DESIGN §3's defaults apply."""
+    """With empty preset defaults and an empty request, docs/design.md §5's defaults apply."""
     job = resolve(RenderRequest(), custom_preset())
     m = job.material
     assert (m.mdf, m.ex, m.ey, m.mu_f, m.alpha, m.beta) == ("multipeak", 100.0, 10.0, 8.5, 2.0, 1.2)
@@ -73,7 +73,7 @@ def test_tier_fills_samples_wavelengths_aa(tier):
 
 
 def test_tiers_are_ordered():
-    """Tiers are the four of DESIGN §6, samples growing toward a spectral reference."""
+    """Tiers are the four of docs/design.md §8, samples growing toward a spectral reference."""
     assert list(TIERS) == ["draft", "standard", "high", "reference"]
     samples = [TIERS[t]["samples"] for t in TIERS]
     assert samples == sorted(samples) and samples[0] < samples[-1]
@@ -131,7 +131,8 @@ def test_cache_key_stable_across_processes():
     code = ("from opaline.model.params import RenderRequest; from opaline.model.presets import get_preset; "
             "from opaline.model.request import resolve; p = get_preset('cd-rom'); "
             "print(resolve(RenderRequest(preset='cd-rom', mu_f=3.0), p).cache_key(p.scene_key()))")
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONHASHSEED": "12345"}
+    # The checkout's package (service/): an installed opaline hashes other shader sources.
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "service"), "PYTHONHASHSEED": "12345"}
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
                          text=True, check=True, timeout=60)
     assert out.stdout.strip() == key("cd-rom", mu_f=3.0)

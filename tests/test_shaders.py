@@ -1,4 +1,4 @@
-"""Shader composition (includes, defines, #line) and the variant cache (service/shaders.py)."""
+"""Shader composition (includes, defines, #line) and the variant cache (opaline.gl.shaders)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Continuous spectrum (service/spectrum.py): anchors, bins and white-balanced weights."""
+"""Continuous spectrum (opaline.model.spectrum): anchors, bins and white-balanced weights."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Stability at the extremes (issue 4; DESIGN.md §3 ranges, §6 degenerate geometry).
+"""Stability at the extremes (issue 4; docs/design.md §5 ranges, §8 degenerate geometry).
 
 For every end of every parameter range (``stability_cases.EXTREMES``, ids name
 the extreme: ``ex=1e6``, ``theta1=-2pi``, ``mu_f=0`` ...):
@@ -226,7 +226,7 @@ def test_probe_agrees_property_multipeak(renderer, mat, seed):
     check_probe(renderer.probe(mat, n, t, l, v), ref.reflected_radiance(mat, n, t, l, v))
 
 
-# -- degenerate geometry (DESIGN §6), case by case ------------------------------------
+# -- degenerate geometry (docs/design.md §8), case by case ------------------------------------
 
 DEGENERATE_MATERIALS = {
     "multipeak": material(MULTIPEAK, kd=0.2),
@@ -421,7 +421,7 @@ degenerate_scene_names: list[str] = []  # a fresh scene (and upload) per test
 def test_degenerate_mesh_and_normal_map_render_finite(renderer, monkeypatch, with_map, fields):
     """The surface shader's guards (zero interpolated normal, zero texel, degenerate
     tangent) keep a render finite and non-negative, and the guarded parts are shaded."""
-    import opaline.gl.renderer as renderer_module
+    from opaline.gl import buffers  # SceneGPU builds the scene there
 
     sphere = get_preset("sphere").model_dump()
     name = f"stability-degenerate-{len(degenerate_scene_names)}"
@@ -429,7 +429,7 @@ def test_degenerate_mesh_and_normal_map_render_finite(renderer, monkeypatch, wit
     preset = Preset.model_validate({**sphere, "name": name,
                                     "normal_map": {"kind": "stability"} if with_map else None})
     mesh, nmap = degenerate_mesh(), degenerate_normal_map() if with_map else None
-    original = renderer_module.build_assets
+    original = buffers.build_assets
     calls = []
 
     def build_assets(p):
@@ -438,7 +438,7 @@ def test_degenerate_mesh_and_normal_map_render_finite(renderer, monkeypatch, wit
             return mesh, nmap
         return original(p)
 
-    monkeypatch.setattr(renderer_module, "build_assets", build_assets)
+    monkeypatch.setattr(buffers, "build_assets", build_assets)
     image = render(renderer, preset, size=64, **fields)
     assert calls, "the renderer no longer builds scenes through presets.build_assets"
     assert_finite_non_negative(image)

@@ -1,4 +1,4 @@
-"""Feature defines and uniform values (service/uniforms.py): only what the material uses."""
+"""Feature defines and uniform values (opaline.gl.uniforms): only what the material uses."""
 
 from __future__ import annotations
 

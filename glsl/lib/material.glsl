@@ -1,6 +1,6 @@
 // The material's MDF per colour channel: the one MDF the variant was compiled
 // with, evaluated at the half vector rotated per channel (eq. 2), or per
-// wavelength and integrated to linear sRGB when WAVELENGTHS > 0 (DESIGN §2).
+// wavelength and integrated to linear sRGB when WAVELENGTHS > 0 (docs/design.md §4.1).
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL
 #include "lib/common.glsl"

@@ -1,5 +1,5 @@
 // Eq. 1: Ashikhmin-Shirley MDF, sqrt((ex+1)(ey+1))/(2π) · hz^((ex·hx²+ey·hy²)/(hx²+hy²)).
-// Written from the projected components (DESIGN §8): hz^e = exp(½·e·log1p(-s²)),
+// Written from the projected components (docs/design.md §2): hz^e = exp(½·e·log1p(-s²)),
 // so neither pow with a huge exponent nor 1 - hz² appears.
 #ifndef MDF_ASHIKHMIN_GLSL
 #define MDF_ASHIKHMIN_GLSL

@@ -1,4 +1,4 @@
-// Ashikhmin-Shirley reflectance around the paper's MDF (DESIGN §1):
+// Ashikhmin-Shirley reflectance around the paper's MDF (docs/design.md §1.5):
 //   f_c = kd·albedo_c/π + ks·D_c(h)·F(v·h) / (4·(v·h)·max(n·l, n·v))
 // returned already multiplied by max(n·l, 0), i.e. radiance per unit irradiance.
 #ifndef REFLECTANCE_GLSL

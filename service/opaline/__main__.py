@@ -1,4 +1,4 @@
-"""``python -m service`` is the ``opaline`` command."""
+"""``python -m opaline`` is the ``opaline`` command."""
 
 from opaline.cli.main import main
 

@@ -1,2 +1,3 @@
 """The GL renderer: headless contexts (EGL, OSMesa), shader composition and
-variants, uniforms, the camera, and the renderer that owns one context."""
+variants, uniforms, the camera, the framebuffers and scenes kept on the GPU, and
+the renderer that owns one context (with its MDF plot and BRDF probe)."""

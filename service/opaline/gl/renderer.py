@@ -9,126 +9,27 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from opaline.gl import uniforms
+from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.probes import Probes
 from opaline.gl.shaders import ProgramCache
 from opaline.lru import BudgetLRU
-from opaline.model.params import Material
-from opaline.model.presets import Preset, build_assets, get_preset
+from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job
 from opaline.model.sampling import sample_offsets
 
 log = logging.getLogger(__name__)
 NORMAL_MAP_UNIT = 1
-TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
 
 
-class Cancelled(Exception):
-    """The render was stopped between samples because nobody waits for it any more."""
-
-
-@dataclass(frozen=True)
-class RenderBudgets:
-    """What one renderer keeps for reuse, each an LRU bounded by count and bytes.
-
-    The target budget must hold one 2048² set (about 218 MB) so that the largest
-    allowed image can render; everything else is evicted oldest first."""
-
-    max_programs: int = 64
-    max_scenes: int = 16
-    scene_bytes: int = 128 * 1024 * 1024
-    max_target_sizes: int = 4
-    target_bytes: int = 2048 * 2048 * TARGET_BYTES_PER_PIXEL
-
-
-@dataclass
-class Frame:
-    """A finished render. ``linear``: premultiplied linear RGBA; ``display``: sRGB RGBA in [0, 1]."""
-
-    linear: np.ndarray | None
-    display: np.ndarray | None
-
-
-class Targets:
-    """Framebuffers for one image size, kept and reused (DESIGN §8)."""
-
-    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
-        self.size = size
-        self.sample_tex = ctx.texture(size, 4, dtype="f4")
-        self.depth = ctx.depth_renderbuffer(size)
-        self.sample_fbo = ctx.framebuffer([self.sample_tex], self.depth)
-        self.accum_tex = ctx.texture(size, 4, dtype="f4")
-        self.accum_fbo = ctx.framebuffer([self.accum_tex])
-        self.display_tex = ctx.texture(size, 4, dtype="f4")
-        self.display_fbo = ctx.framebuffer([self.display_tex])
-
-    @property
-    def nbytes(self) -> int:
-        return self.size[0] * self.size[1] * TARGET_BYTES_PER_PIXEL
-
-    def release(self) -> None:
-        for obj in (
-            self.sample_fbo,
-            self.accum_fbo,
-            self.display_fbo,
-            self.sample_tex,
-            self.depth,
-            self.accum_tex,
-            self.display_tex,
-        ):
-            obj.release()
-
-
-class SceneGPU:
-    """A preset's mesh and normal map, uploaded once."""
-
-    def __init__(self, ctx: moderngl.Context, preset: Preset) -> None:
-        mesh, normal_map = build_assets(preset)
-        self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
-        self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
-        self.normal_map = None
-        if normal_map is not None:
-            height, width = normal_map.shape[:2]
-            # Rows flipped: the map's row 0 is v = 1 (image convention), GL's is v = 0.
-            data = np.ascontiguousarray(normal_map[::-1].astype("f4"))
-            self.normal_map = ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
-            self.normal_map.build_mipmaps()
-            self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-            self.normal_map.repeat_x = self.normal_map.repeat_y = True
-        # Mipmaps add a third to the normal map.
-        self.nbytes = self.vbo.size + self.ibo.size + (
-            self.normal_map.width * self.normal_map.height * 12 * 4 // 3 if self.normal_map else 0)
-        self._vaos: dict[int, moderngl.VertexArray] = {}
-
-    def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
-        found = self._vaos.get(program.glo)
-        if found is None:
-            layout = (self.vbo, "3f 3f 3f 2f", "in_position", "in_normal", "in_tangent", "in_uv")
-            found = ctx.vertex_array(program, [layout], index_buffer=self.ibo, skip_errors=True)
-            self._vaos[program.glo] = found
-        return found
-
-    def drop_vao(self, program_glo: int) -> None:
-        vao = self._vaos.pop(program_glo, None)
-        if vao is not None:
-            vao.release()
-
-    def release(self) -> None:
-        for vao in self._vaos.values():
-            vao.release()
-        for obj in (self.vbo, self.ibo, self.normal_map):
-            if obj is not None:
-                obj.release()
-
-
-class Renderer:
-    """Draws jobs, MDF plots and BRDF probes on its own headless context."""
+class Renderer(Probes):
+    """Draws jobs, and (through ``Probes``) MDF plots and BRDF probes, on its own headless context."""
 
     def __init__(self, backend: str | None = None, gl: GLContext | None = None,
                  budgets: RenderBudgets | None = None) -> None:
@@ -320,66 +221,6 @@ class Renderer:
             },
         )
         self.fullscreen(program)
-
-    # Plots and probes
-
-    def mdf_plot(
-        self, material: Material, size: int, wavelengths: int = 0, aa: str = "none"
-    ) -> np.ndarray:
-        """The MDF over the projected half-vector disc, (size, size, 3) linear float32."""
-        self.gl.make_current()
-        defines = uniforms.mdf_defines(material, wavelengths, aa)
-        defines["PRECISE_PHASE"] = self.gl.has_fp64
-        program = self.programs.get("mdf_plot.glsl", defines)
-        targets = self.targets((size, size))
-        uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
-        uniforms.apply(program, {"u_size": size, "u_aa_scale": 1.0})
-        targets.display_fbo.use()
-        self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-        self.fullscreen(program)
-        return self.read(targets.display_fbo, (size, size))[..., :3]
-
-    def probe(
-        self,
-        material: Material,
-        n: np.ndarray,
-        t: np.ndarray,
-        l: np.ndarray,
-        v: np.ndarray,
-        wavelengths: int = 0,
-    ) -> np.ndarray:
-        """Reflected radiance for each (n, t, l, v) case through the surface shading code."""
-        self.gl.make_current()
-        count = len(n)
-        width = min(count, 256)
-        height = -(-count // width)
-        # aa stays "none" (AA_ANALYTIC false, so not compiled in): a probe has no pixel footprint.
-        defines = uniforms.material_defines(material, wavelengths)
-        defines["PRECISE_PHASE"] = self.gl.has_fp64
-        program = self.programs.get("brdf_probe.glsl", defines)
-        textures = []
-        try:
-            for unit, (name, data) in enumerate(
-                (("u_normal", n), ("u_tangent", t), ("u_light", l), ("u_view", v))
-            ):
-                grid = np.zeros((height * width, 4), dtype="f4")
-                grid[:count, :3] = data
-                tex = self.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
-                textures.append(tex)
-                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                tex.use(location=unit)
-                program[name].value = unit
-            uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
-            targets = self.targets((width, height))
-            targets.display_fbo.use()
-            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-            self.fullscreen(program)
-            image = self.read(targets.display_fbo, (width, height))
-        finally:
-            for tex in textures:
-                tex.release()
-        # Case i sits at GL row i // width; read() gave image order (top row first).
-        return image[::-1].reshape(-1, 4)[:count, :3]
 
     def release(self) -> None:
         self.gl.make_current()

@@ -27,7 +27,7 @@ def mdf_defines(
 def material_defines(
     material: Material, wavelengths: int = 0, aa: str = "none"
 ) -> dict[str, int | bool]:
-    """Only the features this material uses (DESIGN §2, "model only what a scene requires")."""
+    """Only the features this material uses (docs/design.md §4.3)."""
     return {
         **mdf_defines(material, wavelengths, aa),
         "DIFFUSE": material.kd > 0.0 and max(material.albedo) > 0.0,

@@ -1,4 +1,4 @@
-"""Float64 NumPy reference of the shading model (DESIGN.md §1).
+"""Float64 NumPy reference of the shading model (docs/design.md §1).
 
 Each function mirrors one GLSL function in ``glsl/lib`` of the same name, so
 tests can compare the two path by path. All functions broadcast over arrays.
@@ -13,7 +13,7 @@ import numpy as np
 
 from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
 
-EPS_DENOM = 1e-4  # DESIGN §1: every denominator clamped to at least this
+EPS_DENOM = 1e-4  # docs/design.md §2: every denominator clamped to at least this
 EPS_HALF = 1e-6  # |l + v| below this: no half vector, no specular
 TWO_PI = 2.0 * np.pi
 
@@ -28,7 +28,7 @@ def log1p_ratio(s2):
     """-log1p(-s2) / s2, which is 1 at s2 = 0 and grows to the rim.
 
     ``hz**e = exp(e * ln hz)`` with ``ln hz = 0.5 * log1p(-s2)``; dividing by s2
-    here lets the A-S exponent be written from hx², hy² alone (DESIGN §8).
+    here lets the A-S exponent be written from hx², hy² alone (docs/design.md §2).
     """
     s2 = np.asarray(s2, dtype=np.float64)
     u = np.clip(1.0 - s2, 1e-12, 1.0)
@@ -52,7 +52,7 @@ def mdf_multipeak(hx, hy, hz, mu_f, alpha, beta):
 
 
 def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint):
-    """Eq. 4 with the cosine box-filtered over a phase footprint (DESIGN §2).
+    """Eq. 4 with the cosine box-filtered over a phase footprint (docs/design.md §4.2).
 
     The mean of cos(x) over [x - Δ/2, x + Δ/2] is cos(x)·sinc(Δ/2), so the
     bands fade to their average where a pixel spans more than a period.

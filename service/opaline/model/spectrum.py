@@ -1,4 +1,4 @@
-"""Continuous spectrum (DESIGN §2): per-wavelength rotations and CIE weights.
+"""Continuous spectrum (docs/design.md §4.1): per-wavelength rotations and CIE weights.
 
 Wavelength λ gets the rotation θ(λ) interpolated piecewise-linearly through
 (612 nm, 0), (549 nm, θ1), (465 nm, θ2) and extended linearly beyond them. The

@@ -10,8 +10,10 @@ from __future__ import annotations
 import inspect
 import math
 import numbers
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
+
+import numpy as np
 
 
 def integer(name: str, value: Any, lo: int, hi: int) -> int:
@@ -30,6 +32,21 @@ def real(name: str, value: Any, lo: float | None = None, hi: float | None = None
     if bounded and not lo <= value <= hi:
         raise ValueError(f"argument '{name}' must be {wanted}, got {value}")
     return float(value)
+
+
+def positive(name: str, value: Any) -> float:
+    value = real(name, value)
+    if value <= 0.0:
+        raise ValueError(f"argument '{name}' must be > 0, got {value}")
+    return value
+
+
+def sequence(name: str, value: Any, length: int) -> Sequence:
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise ValueError(f"argument '{name}' must be a sequence of {length} numbers, got {value!r}")
+    if len(value) != length:
+        raise ValueError(f"argument '{name}' must have {length} entries, got {len(value)}")
+    return value
 
 
 def call(family: str, kinds: Mapping[str, Callable[..., Any]], kind: str, args: dict) -> Any:

@@ -55,7 +55,7 @@ def etag(key: str, renderer: str = "") -> str:
     """A strong ETag for the image under ``key`` as drawn by ``renderer``.
 
     The same request gives the same bytes on the same GL implementation
-    (DESIGN §7), not across implementations, so the renderer's identity is
+    (docs/design.md §9), not across implementations, so the renderer's identity is
     part of the tag: replicas on different hardware do not share validators.
     """
     if not renderer:

@@ -19,7 +19,7 @@ import urllib.request
 from pathlib import Path
 
 HOST = "127.0.0.1"
-ROOT = Path(__file__).resolve().parents[2]  # service/, the source root
+ROOT = Path(__file__).resolve().parents[2]  # the source root service/, holding this opaline
 PROXY_VARS = ("http_proxy", "https_proxy", "all_proxy", "HTTP_PROXY", "HTTPS_PROXY", "ALL_PROXY")
 
 

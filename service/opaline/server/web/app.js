@@ -29,7 +29,7 @@
     ['tier', 'Quality tier overrides', ['samples', 'wavelengths', 'aa']],
   ];
   const MATERIAL = new Set(GROUPS[0][2]);
-  // Which MDF reads which parameter (DESIGN.md §1); the others are dimmed.
+  // Which MDF reads which parameter (docs/design.md §1); the others are dimmed.
   const MDF_ONLY = { ex: 'ashikhmin', ey: 'ashikhmin', mu_f: 'multipeak', alpha: 'multipeak',
     beta: 'multipeak' };
   // The MDF plot shows D only: these are the material fields it reads.

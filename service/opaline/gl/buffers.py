@@ -1,0 +1,117 @@
+"""What a renderer keeps on the GPU between renders.
+
+Framebuffers for each image size, and each preset's mesh and normal map,
+made once in the renderer's context and released with it: moderngl does not
+release attachments with their framebuffer, and Python's collector must not do
+it from another thread (docs/design.md §10).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from opaline.model.presets import Preset, build_assets
+
+TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
+
+
+class Cancelled(Exception):
+    """The render was stopped between samples because nobody waits for it any more."""
+
+
+@dataclass(frozen=True)
+class RenderBudgets:
+    """What one renderer keeps for reuse, each an LRU bounded by count and bytes.
+
+    The target budget must hold one 2048² set (about 218 MB) so that the largest
+    allowed image can render; everything else is evicted oldest first."""
+
+    max_programs: int = 64
+    max_scenes: int = 16
+    scene_bytes: int = 128 * 1024 * 1024
+    max_target_sizes: int = 4
+    target_bytes: int = 2048 * 2048 * TARGET_BYTES_PER_PIXEL
+
+
+@dataclass
+class Frame:
+    """A finished render. ``linear``: premultiplied linear RGBA; ``display``: sRGB RGBA in [0, 1]."""
+
+    linear: np.ndarray | None
+    display: np.ndarray | None
+
+
+class Targets:
+    """Framebuffers for one image size, kept and reused."""
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+        self.size = size
+        self.sample_tex = ctx.texture(size, 4, dtype="f4")
+        self.depth = ctx.depth_renderbuffer(size)
+        self.sample_fbo = ctx.framebuffer([self.sample_tex], self.depth)
+        self.accum_tex = ctx.texture(size, 4, dtype="f4")
+        self.accum_fbo = ctx.framebuffer([self.accum_tex])
+        self.display_tex = ctx.texture(size, 4, dtype="f4")
+        self.display_fbo = ctx.framebuffer([self.display_tex])
+
+    @property
+    def nbytes(self) -> int:
+        return self.size[0] * self.size[1] * TARGET_BYTES_PER_PIXEL
+
+    def release(self) -> None:
+        for obj in (
+            self.sample_fbo,
+            self.accum_fbo,
+            self.display_fbo,
+            self.sample_tex,
+            self.depth,
+            self.accum_tex,
+            self.display_tex,
+        ):
+            obj.release()
+
+
+class SceneGPU:
+    """A preset's mesh and normal map, uploaded once."""
+
+    def __init__(self, ctx: moderngl.Context, preset: Preset) -> None:
+        mesh, normal_map = build_assets(preset)
+        self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
+        self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
+        self.normal_map = None
+        if normal_map is not None:
+            height, width = normal_map.shape[:2]
+            # Rows flipped: the map's row 0 is v = 1 (image convention), GL's is v = 0.
+            data = np.ascontiguousarray(normal_map[::-1].astype("f4"))
+            self.normal_map = ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
+            self.normal_map.build_mipmaps()
+            self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            self.normal_map.repeat_x = self.normal_map.repeat_y = True
+        # Mipmaps add a third to the normal map.
+        self.nbytes = self.vbo.size + self.ibo.size + (
+            self.normal_map.width * self.normal_map.height * 12 * 4 // 3 if self.normal_map else 0)
+        self._vaos: dict[int, moderngl.VertexArray] = {}
+
+    def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
+        found = self._vaos.get(program.glo)
+        if found is None:
+            layout = (self.vbo, "3f 3f 3f 2f", "in_position", "in_normal", "in_tangent", "in_uv")
+            found = ctx.vertex_array(program, [layout], index_buffer=self.ibo, skip_errors=True)
+            self._vaos[program.glo] = found
+        return found
+
+    def drop_vao(self, program_glo: int) -> None:
+        """Forget the vertex array made for a program that is being released."""
+        vao = self._vaos.pop(program_glo, None)
+        if vao is not None:
+            vao.release()
+
+    def release(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        for obj in (self.vbo, self.ibo, self.normal_map):
+            if obj is not None:
+                obj.release()

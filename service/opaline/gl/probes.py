@@ -1,0 +1,82 @@
+"""Diagnostic draws: the MDF plot over the half-vector disc, and the BRDF probe.
+
+Both run the same GLSL library as the surface shader, outside any scene: the
+plot draws the paper's Figs. 2, 3, 6 and 7 (docs/design.md §3), and the probe
+evaluates the reflectance at given (n, t, l, v) so that tests can hold it
+against the float64 reference case by case.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from opaline.gl import uniforms
+from opaline.model.params import Material
+
+
+class Probes:
+    """The plot and the probe, as methods of ``Renderer``.
+
+    They need what the renderer owns: ``gl``, ``ctx``, ``programs``, ``targets()``,
+    ``fullscreen()`` and ``read()``; a mixin keeps them on the renderer (where the
+    tests, the CLI and the service call them) without this module importing it.
+    """
+
+    def mdf_plot(
+        self, material: Material, size: int, wavelengths: int = 0, aa: str = "none"
+    ) -> np.ndarray:
+        """The MDF over the projected half-vector disc, (size, size, 3) linear float32."""
+        self.gl.make_current()
+        defines = uniforms.mdf_defines(material, wavelengths, aa)
+        defines["PRECISE_PHASE"] = self.gl.has_fp64
+        program = self.programs.get("mdf_plot.glsl", defines)
+        targets = self.targets((size, size))
+        uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
+        uniforms.apply(program, {"u_size": size, "u_aa_scale": 1.0})
+        targets.display_fbo.use()
+        self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+        self.fullscreen(program)
+        return self.read(targets.display_fbo, (size, size))[..., :3]
+
+    def probe(
+        self,
+        material: Material,
+        n: np.ndarray,
+        t: np.ndarray,
+        l: np.ndarray,
+        v: np.ndarray,
+        wavelengths: int = 0,
+    ) -> np.ndarray:
+        """Reflected radiance for each (n, t, l, v) case through the surface shading code."""
+        self.gl.make_current()
+        count = len(n)
+        width = min(count, 256)
+        height = -(-count // width)
+        # aa stays "none" (AA_ANALYTIC false, so not compiled in): a probe has no pixel footprint.
+        defines = uniforms.material_defines(material, wavelengths)
+        defines["PRECISE_PHASE"] = self.gl.has_fp64
+        program = self.programs.get("brdf_probe.glsl", defines)
+        textures = []
+        try:
+            for unit, (name, data) in enumerate(
+                (("u_normal", n), ("u_tangent", t), ("u_light", l), ("u_view", v))
+            ):
+                grid = np.zeros((height * width, 4), dtype="f4")
+                grid[:count, :3] = data
+                tex = self.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
+                textures.append(tex)
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                tex.use(location=unit)
+                program[name].value = unit
+            uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
+            targets = self.targets((width, height))
+            targets.display_fbo.use()
+            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+            self.fullscreen(program)
+            image = self.read(targets.display_fbo, (width, height))
+        finally:
+            for tex in textures:
+                tex.release()
+        # Case i sits at GL row i // width; read() gave image order (top row first).
+        return image[::-1].reshape(-1, 4)[:count, :3]
