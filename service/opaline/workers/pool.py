@@ -1,15 +1,10 @@
 """The worker pool: a bounded queue in front of supervised worker processes.
 
-- admission: each job's time is predicted (``admission.CostModel``); a job
-  that alone would miss the deadline is refused (``TooSlow``, 422), and one
-  that would miss it behind the work already queued is refused too
-  (``Overloaded``, 503 with the predicted wait as Retry-After);
-- a deadline: a job still queued when its deadline passes leaves the queue at
-  once (the reaper), failing with ``DeadlineExceeded``;
-- single flight: a job whose key is queued or running gains a waiter;
-- cancellation: a job whose every waiter left is dropped from the queue, or
-  stopped between samples if it is running;
-- supervision, one ``Slot`` thread per process: watchdog, replacement, recycling.
+Admission (``admission``) refuses a job predicted to miss its deadline, alone
+(422) or behind the queue (503); the reaper drops queued jobs whose deadline
+passed; equal keys share one job; a job whose every waiter left is dropped
+from the queue, or stopped between samples; each ``Slot`` supervises one
+process (watchdog, replacement, recycling).
 """
 
 from __future__ import annotations
@@ -66,9 +61,6 @@ class WorkerPool:
         self._ids = itertools.count(1)
         self._cond = threading.Condition()
         self._stop = threading.Event()
-        self._reaper: threading.Thread | None = None
-
-    # Lifecycle
 
     def start(self, timeout: float | None = None) -> None:
         """Start the workers and wait until each has a context (or failed to make one)."""
@@ -80,18 +72,15 @@ class WorkerPool:
         end = time.monotonic() + (timeout or self.start_timeout_s)
         for slot in self.slots:
             slot.opened.wait(max(0.0, end - time.monotonic()))
-        self._reaper = threading.Thread(target=self._reap, name="opaline-reaper", daemon=True)
-        self._reaper.start()
+        threading.Thread(target=self._reap, name="opaline-reaper", daemon=True).start()
         if not self.ready:
             log.error("no render worker has a GL context: %s",
                       "; ".join(s.error or s.state for s in self.slots))
             return
-        for name, task in (("warmup", self.warmup),
-                           ("calibration", CalibrateTask() if self.calibrate else None)):
-            if task is not None:
-                with self._cond:
-                    self._enqueue(Job(next(self._ids), f"{name}:{uuid.uuid4().hex}", task, name,
-                                      math.inf, 0.0))
+        tasks = [self.warmup, CalibrateTask() if self.calibrate else None]
+        with self._cond:  # first in the queue, never expiring
+            for task in filter(None, tasks):
+                self._enqueue(Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf, 0))
 
     def stop(self, timeout: float = 10.0) -> None:
         """Refuse new jobs, fail the queued ones, and let each worker release its context."""

@@ -15,14 +15,13 @@ import multiprocessing
 import os
 import threading
 import time
-from typing import TYPE_CHECKING, Any
+from collections import Counter
+from collections.abc import Callable
+from typing import Any, Protocol
 
 from opaline.workers import child
 from opaline.workers.errors import DeadlineExceeded, Unavailable
-
-if TYPE_CHECKING:
-    from opaline.workers.job import Job
-    from opaline.workers.pool import WorkerPool
+from opaline.workers.job import Job
 
 log = logging.getLogger(__name__)
 SPAWN = multiprocessing.get_context("spawn")
@@ -30,8 +29,29 @@ POLL_S = 0.05
 RESPAWN_BACKOFF_S = (0.5, 1.0, 2.0, 5.0, 10.0)
 
 
+class Supervisor(Protocol):
+    """What a slot needs of its pool (``opaline.workers.pool.WorkerPool``)."""
+
+    factory: Callable[[], Any]
+    lp_threads: int | None
+    start_timeout_s: float
+    render_timeout_s: float
+    max_renders: int
+    max_rss_bytes: int
+    stopping: bool
+    counters: Counter[str]
+
+    def take(self, slot: Slot) -> Job | None: ...
+
+    def finish(self, job: Job, reply: child.Reply) -> None: ...
+
+    def fail(self, job: Job, exc: Exception) -> None: ...
+
+    def wait_stop(self, seconds: float) -> None: ...
+
+
 class Slot:
-    def __init__(self, pool: WorkerPool, index: int) -> None:
+    def __init__(self, pool: Supervisor, index: int) -> None:
         self.pool = pool
         self.name = f"render-{index}"
         self.process: Any = None
