@@ -66,3 +66,21 @@ def test_relative_links_in_markdown_resolve():
             if not path.exists():
                 dead.append(f"{name}: {target}")
     assert not dead, "dead links:\n" + "\n".join(dead)
+
+
+def test_every_module_is_in_the_architecture_and_the_readme_layout():
+    """docs/architecture.md has a line for every module, and the README's Layout names it."""
+    package = ROOT / "service" / "opaline"
+    architecture = (ROOT / "docs" / "architecture.md").read_text()
+    readme = (ROOT / "README.md").read_text()
+    layout = readme[readme.index("## Layout"):]
+    missing = []
+    for path in sorted(package.rglob("*.py")):
+        rel = path.relative_to(package).as_posix()
+        if path.name in ("__init__.py", "__main__.py") or rel.startswith("_"):
+            continue
+        if rel not in architecture:
+            missing.append(f"docs/architecture.md: {rel}")
+        if path.name not in layout:
+            missing.append(f"README Layout: {rel}")
+    assert not missing, "\n".join(missing)
