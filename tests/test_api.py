@@ -7,6 +7,7 @@ import logging
 import threading
 import time
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -458,3 +459,20 @@ def test_openapi_documents_readiness_etag_and_mdf_bounds(client):
         assert "ETag" in spec["paths"][path][method]["responses"]["200"]["headers"]
     mdf = {p["name"]: p["schema"] for p in spec["paths"]["/v1/mdf"]["get"]["parameters"]}
     assert mdf["wavelengths"]["minimum"] == 0 and mdf["wavelengths"]["maximum"] == 128
+
+
+def test_openapi_says_what_each_health_route_means(client):
+    """/healthz is documented as liveness, /readyz as readiness with per-worker detail."""
+    paths = client.get("/openapi.json").json()["paths"]
+    health, ready = paths["/healthz"]["get"], paths["/readyz"]["get"]
+    assert "liveness" in health["summary"].lower() and "/readyz" in health["description"]
+    assert "readiness" in ready["summary"].lower() and "503" in ready["description"]
+    workers = client.get("/readyz").json()["workers"][0]
+    assert {"pid", "state", "renders", "rss_bytes", "restarts"} <= workers.keys()
+
+
+def test_container_health_check_asks_readiness():
+    """The image is unhealthy when no worker can render: its HEALTHCHECK asks /readyz."""
+    dockerfile = (Path(__file__).resolve().parent.parent / "Dockerfile").read_text()
+    check = dockerfile[dockerfile.index("HEALTHCHECK"):]
+    assert "/readyz" in check.split("\n\n")[0] and "/healthz" not in check.split("\n\n")[0]
