@@ -196,3 +196,24 @@ def test_sigkill_of_a_batch_leaves_no_process_behind(tmp_path, env):
     while any(rss(pid) for pid in workers) and time.monotonic() < end:
         time.sleep(0.05)
     assert not any(Path(f"/proc/{pid}").exists() and rss(pid) for pid in workers)
+
+
+def test_the_http_process_never_loads_gl(backend, tmp_path):
+    """After start-up and a render, the HTTP process has not imported moderngl or glcontext:
+    only its worker processes touch GL."""
+    script = tmp_path / "probe.py"
+    script.write_text(
+        "import sys\n"
+        "from fastapi.testclient import TestClient\n"
+        "from opaline.server.api import create_app\n"
+        "from opaline.settings import Settings\n"
+        "if __name__ == '__main__':\n"
+        f"    app = create_app(Settings(gl_backend={backend!r}, calibrate=False))\n"
+        "    with TestClient(app) as client:\n"
+        "        assert client.get('/v1/render?width=32&height=32&quality=draft')"
+        ".status_code == 200\n"
+        "    print(sorted({'moderngl', 'glcontext'} & set(sys.modules)))\n")
+    result = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                            timeout=120, env=loopback_env())
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip().splitlines()[-1] == "[]"

@@ -15,6 +15,7 @@ from functools import partial
 from typing import TYPE_CHECKING
 
 from opaline.workers.errors import RenderFailed
+from opaline.workers.factory import RendererFactory
 from opaline.workers.job import Job
 from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import ImageTask
@@ -43,9 +44,7 @@ class GLProcesses:
     def __init__(self, jobs: int, backend: str | None) -> None:
         import os
 
-        from opaline.gl.renderer import Renderer
-
-        self.pool = WorkerPool(partial(Renderer, backend), workers=jobs, queue_size=1 << 20,
+        self.pool = WorkerPool(RendererFactory(backend), workers=jobs, queue_size=1 << 20,
                                deadline_s=NO_DEADLINE_S, render_timeout_s=RENDER_LIMIT_S,
                                lp_threads=max(1, (os.cpu_count() or 1) // jobs), calibrate=False)
         self.pool.start()

@@ -13,7 +13,6 @@ from __future__ import annotations
 import asyncio
 import os
 from contextlib import asynccontextmanager
-from functools import partial
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -32,6 +31,7 @@ from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
 from opaline.server.service import Service, SettingsDep, get_service
 from opaline.settings import Settings, get_settings, memory_budget_bytes
+from opaline.workers.factory import RendererFactory
 from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import ImageTask
 
@@ -127,15 +127,12 @@ async def lifespan(app: FastAPI):
         await asyncio.to_thread(app.state.pool.stop)
 
 
-def renderer_for(settings: Settings) -> Any:
-    """The factory each worker process calls to make its renderer (picklable)."""
-    from opaline.gl.renderer import RenderBudgets, Renderer
-
+def renderer_for(settings: Settings) -> RendererFactory:
+    """The recipe each worker process follows to make its renderer."""
     mib = 1024 * 1024
-    budgets = RenderBudgets(max_programs=settings.worker_programs,
-                            scene_bytes=settings.worker_scene_mb * mib,
-                            target_bytes=settings.worker_target_mb * mib)
-    return partial(Renderer, settings.gl_backend, budgets=budgets)
+    return RendererFactory(settings.gl_backend, max_programs=settings.worker_programs,
+                           scene_bytes=settings.worker_scene_mb * mib,
+                           target_bytes=settings.worker_target_mb * mib)
 
 
 def create_app(settings: Settings | None = None, renderer_factory: Any = None) -> FastAPI:

@@ -1,0 +1,22 @@
+"""How a worker process makes its renderer: a picklable recipe, so that the parent never
+imports moderngl or touches GL itself."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class RendererFactory:
+    backend: str | None = None
+    max_programs: int = 64
+    scene_bytes: int = 128 * 1024 * 1024
+    target_bytes: int = 256 * 1024 * 1024
+
+    def __call__(self) -> Any:
+        from opaline.gl.renderer import RenderBudgets, Renderer
+
+        budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
+                                target_bytes=self.target_bytes)
+        return Renderer(self.backend, budgets=budgets)
