@@ -217,3 +217,28 @@ def test_the_http_process_never_loads_gl(backend, tmp_path):
                             timeout=120, env=loopback_env())
     assert result.returncode == 0, result.stderr[-2000:]
     assert result.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_a_client_that_leaves_takes_its_queued_render_with_it(env):
+    """A request whose client disconnects while it waits in the queue is dropped: the
+    worker never renders it (counted as cancelled)."""
+    import socket
+
+    with LocalServer(env={**env, "OPALINE_DEADLINE_S": "300",
+                          "OPALINE_RENDER_TIMEOUT_S": "300"}) as server:
+        busy = threading.Thread(target=get, args=(
+            server.base + "/v1/mdf?size=2048&wavelengths=64", 300))
+        busy.start()
+        time.sleep(0.5)
+        with socket.create_connection(("127.0.0.1", server.port)) as sock:
+            sock.sendall(b"GET /v1/render?width=64&height=64&quality=draft&mu_f=7 HTTP/1.1\r\n"
+                         b"Host: 127.0.0.1\r\n\r\n")
+            time.sleep(0.5)  # queued behind the plot
+        end = time.monotonic() + 10
+        text = ""
+        while time.monotonic() < end and "opaline_jobs_cancelled_total 1.0" not in text:
+            text = get(server.base + "/metrics")[1].decode()
+            time.sleep(0.1)
+        busy.join(300)
+        assert "opaline_jobs_cancelled_total 1.0" in text
+        assert 'opaline_render_seconds_count{preset="sphere"}' not in text
