@@ -11,6 +11,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from opaline.model.physical_params import PhysicalFields, PhysicalMaterial
+
 TWO_PI = 2.0 * math.pi
 
 MdfName = Literal["ashikhmin", "multipeak"]
@@ -36,7 +38,7 @@ def wavelengths_ok(value: int | None) -> int | None:
     return value
 
 
-class MaterialFields(BaseModel):
+class MaterialFields(PhysicalFields):
     """Material parameters; ``None`` means "take the preset's value"."""
 
     model_config = STRICT
@@ -130,7 +132,7 @@ class RenderRequest(RenderFields):
     preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
 
 
-class Material(BaseModel):
+class Material(PhysicalMaterial):
     """A fully specified material, as the renderer consumes it."""
 
     model_config = STRICT

@@ -125,6 +125,11 @@ def specular_rgb(material, n, t, l, v, wavelengths=0):
 def specular(material, frame, l, v, wavelengths=0):
     """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel in a (t, b, n) frame; zero where h is
     undefined."""
+    if getattr(material, "iridescence", "rotation") != "rotation":
+        # Imported here: the physical sources build on this module's functions.
+        from opaline.model import physical
+
+        return physical.specular(material, frame, l, v, wavelengths)
     t, b, n = frame
     sum_lv = l + v
     length = np.linalg.norm(sum_lv, axis=-1, keepdims=True)

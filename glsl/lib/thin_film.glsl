@@ -1,0 +1,142 @@
+// Thin-film colour (docs/physics.md §1): Airy reflectance of a film of index
+// u_film_ior and thickness d (nm) on a substrate of index u_substrate_ior, under
+// air, at cos θ1 = v·h. Real indices make the Fresnel amplitudes a = r12 and
+// b = r23 real and signed (the sign is the interface's 0 or π phase shift):
+//   R(φ) = (a² + b² + 2ab·cos φ) / (1 + a²b² + 2ab·cos φ),  φ = 4π·n·d·cos θ2/λ,
+// averaged over s and p; total internal reflection gives 1. Float64 twin:
+// opaline/model/thinfilm.py.
+#ifndef THIN_FILM_GLSL
+#define THIN_FILM_GLSL
+#include "lib/common.glsl"
+#include "lib/material.glsl"
+
+uniform float u_film_ior;
+uniform float u_substrate_ior;
+uniform float u_film_thickness_max;
+
+// This fragment's thickness in nm, set by the surface from its thickness field;
+// negative (the probe, a surface without a field) means the maximum, as in KHR.
+float film_thickness = -1.0;
+
+float film_thickness_nm() {
+    return film_thickness >= 0.0 ? film_thickness : u_film_thickness_max;
+}
+
+float film_ratio(float num, float den) {
+    return num / (abs(den) > 1e-30 ? den : 1e-30);
+}
+
+// Both interfaces for s (.x) and p (.y); false where light cannot get through.
+bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    float nf = u_film_ior;
+    float ns = u_substrate_ior;
+    float sin1_sq = 1.0 - cos1 * cos1;
+    float cos2_sq = 1.0 - sin1_sq / (nf * nf);
+    float cos3_sq = 1.0 - sin1_sq / (ns * ns);
+    cos2 = sqrt(max(cos2_sq, 0.0));
+    float cos3 = sqrt(max(cos3_sq, 0.0));
+    r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
+               film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
+    r23 = vec2(film_ratio(nf * cos2 - ns * cos3, nf * cos2 + ns * cos3),
+               film_ratio(ns * cos2 - nf * cos3, ns * cos2 + nf * cos3));
+    return cos2_sq > 0.0 && cos3_sq > 0.0;
+}
+
+#if WAVELENGTHS > 0
+uniform float u_wavelength_nm[WAVELENGTHS];
+
+float film_airy(float a, float b, float c) {
+    float ab = a * b;
+    // The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
+    return max(a * a + b * b + 2.0 * ab * c, 0.0) / max(1.0 + ab * ab + 2.0 * ab * c, 1e-30);
+}
+
+// Σ_i w_i·R(λ_i), with the CIE weights of the spectral path (material.glsl).
+vec3 film_rgb(float cos1, float d) {
+    float cos2;
+    vec2 r12, r23;
+    if (!film_interfaces(cos1, cos2, r12, r23)) {
+        return vec3(1.0);
+    }
+    float opd = 2.0 * u_film_ior * d * cos2;  // nm
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        // φ in cycles, reduced before the cosine: float trig never sees a big argument.
+        float cycles = opd / u_wavelength_nm[i];
+        float c = cos(TWO_PI * fract(cycles));
+        float r = 0.5 * (film_airy(r12.x, r23.x, c) + film_airy(r12.y, r23.y, c));
+        sum += u_spectral_weight[i] * r;
+    }
+    return max(sum, vec3(0.0));
+}
+#else
+// Fast path (Belcour & Barla 2017): R(φ) = c0 + 2·Σ_m c_m cos(mφ) with
+// c0 = (a² + b² - 2x²)/(1 - x²), c_m = -(1-a²)(1-b²)/(1-x²)·(-x)^m, x = ab;
+// each cos(mφ) integrated against the colour weights in closed form from three
+// Gaussians per channel over wavenumber (opaline/model/visible.py).
+#define FILM_TERMS 3
+uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
+uniform vec3 u_film_sens_centre[3];  // µm⁻¹
+uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
+
+vec3 film_sensitivity(float opd_um, float shift) {
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < 3; ++k) {
+        vec3 cycles = u_film_sens_centre[k] * opd_um;
+        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um;
+        vec3 damp = exp(-2.0 * sigma_opd * sigma_opd);
+        sum += u_film_sens_weight[k] * cos(TWO_PI * fract(cycles) + shift) * damp;
+    }
+    return sum;
+}
+
+// Σ_{m > M} |x|^m·∫ ŵ cos(m(2π·opd·ν + shift)) dν, each Gaussian at its centre:
+// Re(z^(M+1)/(1 - z)), z = |x|·e^{iθ}, damped as the term M + 1. It matters near
+// grazing, where |x| nears 1 and a film of thickness 0 must still be the bare
+// substrate; elsewhere it is below 1e-4.
+vec3 film_tail(float x, float opd_um, float shift) {
+    const float M = float(FILM_TERMS);
+    vec3 sum = vec3(0.0);
+    float x_m1 = pow(x, M + 1.0);
+    for (int k = 0; k < 3; ++k) {
+        vec3 theta = TWO_PI * fract(u_film_sens_centre[k] * opd_um) + shift;
+        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um * (M + 1.0);
+        vec3 damp = exp(-2.0 * sigma_opd * sigma_opd);
+        vec3 num = x_m1 * cos((M + 1.0) * theta) - x_m1 * x * cos(M * theta);
+        vec3 den = max(1.0 - 2.0 * x * cos(theta) + x * x, 1e-12);
+        sum += u_film_sens_weight[k] * damp * num / den;
+    }
+    return sum;
+}
+
+vec3 film_series(float a, float b, float opd_um) {
+    float x = a * b;
+    float one_minus = max(1.0 - x * x, 1e-30);
+    float c0 = (a * a + b * b - 2.0 * x * x) / one_minus;
+    float amp = -(1.0 - a * a) * (1.0 - b * b) / one_minus;
+    float shift = x > 0.0 ? PI : 0.0;
+    vec3 rgb = vec3(c0);
+    float power = 1.0;
+    for (int m = 1; m <= FILM_TERMS; ++m) {
+        power *= abs(x);
+        // m·shift is 0 or a multiple of π: reduced to one cycle for the cosine.
+        float phase = mod(float(m) * shift, TWO_PI);
+        rgb += 2.0 * amp * power * film_sensitivity(float(m) * opd_um, phase);
+    }
+    return rgb + 2.0 * amp * film_tail(abs(x), opd_um, shift);
+}
+
+vec3 film_rgb(float cos1, float d) {
+    float cos2;
+    vec2 r12, r23;
+    if (!film_interfaces(cos1, cos2, r12, r23)) {
+        return vec3(1.0);
+    }
+    float opd_um = 2e-3 * u_film_ior * d * cos2;
+    vec3 rgb = 0.5 * (film_series(r12.x, r23.x, opd_um) + film_series(r12.y, r23.y, opd_um));
+    return max(rgb, vec3(0.0));
+}
+#endif
+
+#endif

@@ -1,0 +1,54 @@
+"""Defines and uniforms of the physical iridescence sources (glsl/lib/thin_film.glsl,
+glsl/lib/grating.glsl): a material with ``iridescence`` other than ``rotation``
+compiles the A-S lobe with its source's define, and nothing of the paper's
+rotation or multi-peak MDF."""
+
+from __future__ import annotations
+
+from opaline.model import grating, visible
+from opaline.model.spectrum import sample_wavelengths
+
+
+def is_physical(material) -> bool:
+    return material.iridescence != "rotation"
+
+
+def defines(material) -> dict[str, int | bool]:
+    """Overrides of the paper's feature defines for a physical material."""
+    if not is_physical(material):
+        return {"IRIDESCENCE_THIN_FILM": False, "IRIDESCENCE_GRATING": False}
+    thin_film = material.iridescence == "thin-film"
+    return {
+        "IRIDESCENCE_THIN_FILM": thin_film,
+        "IRIDESCENCE_GRATING": not thin_film,
+        "MDF_ASHIKHMIN": True,
+        "MDF_MULTIPEAK": False,
+        "AA_ANALYTIC": False,
+        # The film's Airy reflectance is its Fresnel term; a grating keeps Schlick's
+        # (the reflectance of its coating) where f0 < 1.
+        "FRESNEL": not thin_film and material.f0 < 1.0,
+    }
+
+
+def uniforms(material, wavelengths: int) -> dict[str, object]:
+    if not is_physical(material):
+        return {}
+    values: dict[str, object] = {
+        "u_film_ior": material.film_ior,
+        "u_substrate_ior": material.substrate_ior,
+        "u_film_thickness_min": material.film_thickness_min,
+        "u_film_thickness_max": material.film_thickness_max,
+        "u_grating_pitch_nm": 1000.0 * material.grating_pitch,
+        "u_grating_depth_nm": material.grating_depth,
+        "u_grating_orders": material.grating_orders,
+    }
+    if wavelengths > 0:
+        values["u_wavelength_nm"] = [float(x) for x in sample_wavelengths(wavelengths)]
+    else:
+        gaussians = visible.sensitivity_gaussians()
+        values["u_film_sens_weight"] = [tuple(g) for g in gaussians[..., 0]]
+        values["u_film_sens_centre"] = [tuple(g) for g in gaussians[..., 1]]
+        values["u_film_sens_sigma"] = [tuple(g) for g in gaussians[..., 2]]
+        values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
+        values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
+    return values
