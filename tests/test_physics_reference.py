@@ -18,7 +18,7 @@ from scipy.special import jv
 
 from opaline.model import grating, thinfilm, visible
 from opaline.model.params import Material
-from opaline.model.reference import normalize, shading_frame
+from opaline.model.reference import shading_frame
 
 
 def fresnel_unpolarised(cos_i, n1, n2):
@@ -119,6 +119,17 @@ def test_fit_reproduces_the_colour_weights():
     assert np.allclose(visible.sensitivity(0.0, 0.0), 1.0)
     grid, table = visible.density_table()
     assert np.allclose(np.trapezoid(table, grid, axis=0), 1.0, atol=1e-9)
+    # The same weights per µm⁻¹ of wavenumber, against the sum of the Gaussians.
+    lam = np.arange(380.0, 781.0, 1.0)
+    nu = 1000.0 / lam
+    per_nu = visible.density_at(lam) * (lam[:, None] ** 2) / 1000.0
+    g = visible.sensitivity_gaussians()
+    model = sum(
+        g[k, :, 0] / (g[k, :, 2] * np.sqrt(2 * np.pi))
+        * np.exp(-((nu[:, None] - g[k, :, 1]) ** 2) / (2 * g[k, :, 2] ** 2))
+        for k in range(3)
+    )
+    assert np.all(np.abs(model - per_nu).max(axis=0) < 0.03 * per_nu.max(axis=0))
 
 
 @pytest.mark.parametrize("m", range(0, 9))

@@ -31,9 +31,10 @@ bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float nf = u_film_ior;
     float ns = u_substrate_ior;
-    float sin1_sq = 1.0 - cos1 * cos1;
-    float cos2_sq = 1.0 - sin1_sq / (nf * nf);
-    float cos3_sq = 1.0 - sin1_sq / (ns * ns);
+    // cos²θ2 = 1 - sin²θ1/n² as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1 rounds
+    // to 1 in float, which would turn a film of index 1 into total reflection.
+    float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
+    float cos3_sq = (ns * ns - 1.0 + cos1 * cos1) / (ns * ns);
     cos2 = sqrt(max(cos2_sq, 0.0));
     float cos3 = sqrt(max(cos3_sq, 0.0));
     r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),

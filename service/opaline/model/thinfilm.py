@@ -27,9 +27,11 @@ FAST_TERMS = 3  # Fourier terms of the fast path; |ab|^4 < 1e-3 below grazing
 def interfaces(cos1, n_film, n_sub):
     """(cos θ2, r12 s/p, r23 s/p, tir): Fresnel amplitudes at both interfaces."""
     cos1 = np.clip(np.asarray(cos1, dtype=np.float64), 0.0, 1.0)
-    sin1_sq = 1.0 - cos1 * cos1
-    cos2_sq = 1.0 - sin1_sq / (n_film * n_film)
-    cos3_sq = 1.0 - sin1_sq / (n_sub * n_sub)
+    # cos²θ2 = 1 - sin²θ1/n² written as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1
+    # rounds to 1 in fp32, which would turn a film of index 1 into total reflection.
+    cos1_sq = cos1 * cos1
+    cos2_sq = (n_film * n_film - 1.0 + cos1_sq) / (n_film * n_film)
+    cos3_sq = (n_sub * n_sub - 1.0 + cos1_sq) / (n_sub * n_sub)
     tir = (cos2_sq <= 0.0) | (cos3_sq <= 0.0)
     cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
     cos3 = np.sqrt(np.maximum(cos3_sq, 0.0))
