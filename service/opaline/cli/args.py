@@ -18,6 +18,7 @@ class CliError(Exception):
 
 def parameter_help() -> str:
     lines = ["parameters for --set NAME=VALUE (unset ones come from the preset):"]
+    column = max(16, *(len(name) + 1 for name in RenderRequest.model_fields))
     for name, info in RenderRequest.model_fields.items():
         if name == "preset":
             continue
@@ -26,7 +27,7 @@ def parameter_help() -> str:
         # Descriptions state their range in words; add the bounds where one does not.
         if allowed and "…" not in desc:
             desc += f" Range {allowed}."
-        lines.append(f"  {name:<16} {desc}")
+        lines.append(f"  {name:<{column}} {desc}")
     return "\n".join(lines)
 
 

@@ -16,7 +16,7 @@ def is_physical(material) -> bool:
 def defines(material) -> dict[str, int | bool]:
     """Overrides of the paper's feature defines for a physical material."""
     if not is_physical(material):
-        return {"IRIDESCENCE_THIN_FILM": False, "IRIDESCENCE_GRATING": False}
+        return {}  # the paper's variants stay exactly as they were
     thin_film = material.iridescence == "thin-film"
     return {
         "IRIDESCENCE_THIN_FILM": thin_film,
