@@ -58,6 +58,9 @@ uniform vec3 u_ambient;
 #ifdef NORMAL_MAP
 uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
 #endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
+uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickness texture
+#endif
 
 out vec4 frag_color;
 
@@ -85,6 +88,10 @@ void main() {
     }
 #endif
     mat3 frame = shading_frame(n, t);
+#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
+    film_thickness = mix(u_film_thickness_min, u_film_thickness_max,
+                         texture(u_thickness_map, v_uv).r);
+#endif
     vec3 v = normalize(u_eye - v_world);
 
     vec3 radiance = vec3(0.0);

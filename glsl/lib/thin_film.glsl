@@ -12,6 +12,7 @@
 
 uniform float u_film_ior;
 uniform float u_substrate_ior;
+uniform float u_film_thickness_min;
 uniform float u_film_thickness_max;
 
 // This fragment's thickness in nm, set by the surface from its thickness field;

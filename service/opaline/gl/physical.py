@@ -5,6 +5,9 @@ rotation or multi-peak MDF."""
 
 from __future__ import annotations
 
+import moderngl
+import numpy as np
+
 from opaline.model import grating, visible
 from opaline.model.spectrum import sample_wavelengths
 
@@ -52,3 +55,24 @@ def uniforms(material, wavelengths: int) -> dict[str, object]:
         values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
         values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
     return values
+
+
+THICKNESS_UNIT = 2
+
+
+def thickness_texture(ctx: moderngl.Context, field) -> moderngl.Texture | None:
+    """A thickness field as a tiling, mipmapped one-channel float texture."""
+    if field is None:
+        return None
+    height, width = field.shape
+    # Rows flipped: the field's row 0 is v = 1 (image convention), GL's is v = 0.
+    data = np.ascontiguousarray(field[::-1].astype("f4"))
+    texture = ctx.texture((width, height), 1, data.tobytes(), dtype="f4")
+    texture.build_mipmaps()
+    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    texture.repeat_x = texture.repeat_y = True
+    return texture
+
+
+def uses_thickness_map(material, preset) -> bool:
+    return material.iridescence == "thin-film" and preset.thickness_map is not None

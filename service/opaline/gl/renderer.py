@@ -14,12 +14,12 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from opaline.gl import uniforms
+from opaline.gl import physical, uniforms
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
 from opaline.gl.shaders import ProgramCache
 from opaline.model.params import Material
-from opaline.model.presets import Preset, build_assets, get_preset
+from opaline.model.presets import Preset, build_assets, build_thickness, get_preset
 from opaline.model.request import Job
 from opaline.model.sampling import sample_offsets
 
@@ -78,6 +78,7 @@ class SceneGPU:
             self.normal_map.build_mipmaps()
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.normal_map.repeat_x = self.normal_map.repeat_y = True
+        self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset))
         self._vaos: dict[int, moderngl.VertexArray] = {}
 
     def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
@@ -91,7 +92,7 @@ class SceneGPU:
     def release(self) -> None:
         for vao in self._vaos.values():
             vao.release()
-        for obj in (self.vbo, self.ibo, self.normal_map):
+        for obj in (self.vbo, self.ibo, self.normal_map, self.thickness_map):
             if obj is not None:
                 obj.release()
 
@@ -170,6 +171,8 @@ class Renderer:
         defines["NORMAL_MAP"] = preset.normal_map is not None
         defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
         defines["LIGHT_COUNT"] = len(preset.lights)
+        if physical.uses_thickness_map(job.material, preset):
+            defines["THICKNESS_MAP"] = True
         return defines
 
     def _draw_samples(
@@ -213,6 +216,9 @@ class Renderer:
             values["u_normal_map"] = NORMAL_MAP_UNIT
             # Bound once: the accumulate pass between samples binds unit 0 only.
             normal_map.use(location=NORMAL_MAP_UNIT)
+        if defines.get("THICKNESS_MAP"):
+            values["u_thickness_map"] = physical.THICKNESS_UNIT
+            scene.thickness_map.use(location=physical.THICKNESS_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
         multi = len(offsets) > 1
