@@ -173,6 +173,8 @@ class Renderer:
         defines["LIGHT_COUNT"] = len(preset.lights)
         if physical.uses_thickness_map(job.material, preset):
             defines["THICKNESS_MAP"] = True
+        if physical.uses_transmission(job.material, preset):
+            defines["TRANSMISSION"] = True
         return defines
 
     def _draw_samples(
@@ -216,6 +218,9 @@ class Renderer:
             values["u_normal_map"] = NORMAL_MAP_UNIT
             # Bound once: the accumulate pass between samples binds unit 0 only.
             normal_map.use(location=NORMAL_MAP_UNIT)
+        if defines.get("TRANSMISSION"):
+            values["u_backdrop"] = physical.backdrop_radiance(
+                preset.background, job.tonemap, job.exposure)
         if defines.get("THICKNESS_MAP"):
             values["u_thickness_map"] = physical.THICKNESS_UNIT
             scene.thickness_map.use(location=physical.THICKNESS_UNIT)

@@ -71,6 +71,8 @@ class Preset(BaseModel):
     normal_map: Generator | None = None
     # Film thickness in [0, 1] over uv, mapped to [film_thickness_min, max] (thin film only).
     thickness_map: Generator | None = None
+    # A free film (soap bubble): the background shows through what the film does not reflect.
+    transmission: bool = False
     rotation_deg: Vec3 = (0.0, 0.0, 0.0)
     camera: Camera
     lights: Annotated[list[Light], Field(min_length=1, max_length=8)]
