@@ -74,60 +74,19 @@ vec3 film_rgb(float cos1, float d) {
 }
 #else
 // Fast path (Belcour & Barla 2017): R(φ) = c0 + 2·Σ_m c_m cos(mφ) with
-// c0 = (a² + b² - 2x²)/(1 - x²), c_m = -(1-a²)(1-b²)/(1-x²)·(-x)^m, x = ab;
-// each cos(mφ) integrated against the colour weights in closed form from three
-// Gaussians per channel over wavenumber (opaline/model/visible.py).
-#define FILM_TERMS 3
+// c0 = (a² + b² - 2x²)/(1 - x²), c_m = A·q^m, A = -(1-a²)(1-b²)/(1-x²), q = -x,
+// x = ab; each cos(mφ) integrated against the colour weights in closed form from
+// three Gaussians per channel over wavenumber (opaline/model/visible.py):
+//   ∫ ŵ cos(2π·m·opd·ν) dν = Σ_k w_k cos(m·θ_k) d_k^(m²),  θ_k = 2π·μ_k·opd,
+//   d_k = exp(-2(π·σ_k·opd)²).
+// The three terms are evaluated from one cosine and one exponential per Gaussian
+// (Chebyshev for cos mθ, powers for d^(m²)), shared by s and p; the terms m > 3,
+// which matter near grazing where |q| nears 1, are summed as the geometric series
+// Re(z⁴/(1 - z)), z = q·e^{iθ}, damped as the term m = 4. The float64 twin
+// (model/thinfilm.py) evaluates the same sums term by term.
 uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
 uniform vec3 u_film_sens_centre[3];  // µm⁻¹
 uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
-
-vec3 film_sensitivity(float opd_um, float shift) {
-    vec3 sum = vec3(0.0);
-    for (int k = 0; k < 3; ++k) {
-        vec3 cycles = u_film_sens_centre[k] * opd_um;
-        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um;
-        vec3 damp = exp(-2.0 * sigma_opd * sigma_opd);
-        sum += u_film_sens_weight[k] * cos(TWO_PI * fract(cycles) + shift) * damp;
-    }
-    return sum;
-}
-
-// Σ_{m > M} |x|^m·∫ ŵ cos(m(2π·opd·ν + shift)) dν, each Gaussian at its centre:
-// Re(z^(M+1)/(1 - z)), z = |x|·e^{iθ}, damped as the term M + 1. It matters near
-// grazing, where |x| nears 1 and a film of thickness 0 must still be the bare
-// substrate; elsewhere it is below 1e-4.
-vec3 film_tail(float x, float opd_um, float shift) {
-    const float M = float(FILM_TERMS);
-    vec3 sum = vec3(0.0);
-    float x_m1 = pow(x, M + 1.0);
-    for (int k = 0; k < 3; ++k) {
-        vec3 theta = TWO_PI * fract(u_film_sens_centre[k] * opd_um) + shift;
-        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um * (M + 1.0);
-        vec3 damp = exp(-2.0 * sigma_opd * sigma_opd);
-        vec3 num = x_m1 * cos((M + 1.0) * theta) - x_m1 * x * cos(M * theta);
-        vec3 den = max(1.0 - 2.0 * x * cos(theta) + x * x, 1e-12);
-        sum += u_film_sens_weight[k] * damp * num / den;
-    }
-    return sum;
-}
-
-vec3 film_series(float a, float b, float opd_um) {
-    float x = a * b;
-    float one_minus = max(1.0 - x * x, 1e-30);
-    float c0 = (a * a + b * b - 2.0 * x * x) / one_minus;
-    float amp = -(1.0 - a * a) * (1.0 - b * b) / one_minus;
-    float shift = x > 0.0 ? PI : 0.0;
-    vec3 rgb = vec3(c0);
-    float power = 1.0;
-    for (int m = 1; m <= FILM_TERMS; ++m) {
-        power *= abs(x);
-        // m·shift is 0 or a multiple of π: reduced to one cycle for the cosine.
-        float phase = mod(float(m) * shift, TWO_PI);
-        rgb += 2.0 * amp * power * film_sensitivity(float(m) * opd_um, phase);
-    }
-    return rgb + 2.0 * amp * film_tail(abs(x), opd_um, shift);
-}
 
 vec3 film_rgb(float cos1, float d) {
     float cos2;
@@ -136,7 +95,37 @@ vec3 film_rgb(float cos1, float d) {
         return vec3(1.0);
     }
     float opd_um = 2e-3 * u_film_ior * d * cos2;
-    vec3 rgb = 0.5 * (film_series(r12.x, r23.x, opd_um) + film_series(r12.y, r23.y, opd_um));
+    vec2 x = r12 * r23;  // (s, p)
+    vec2 one_minus = max(1.0 - x * x, 1e-30);
+    vec2 c0 = (r12 * r12 + r23 * r23 - 2.0 * x * x) / one_minus;
+    vec2 amp = -(1.0 - r12 * r12) * (1.0 - r23 * r23) / one_minus;
+    vec2 q = -x;
+    vec2 q2 = q * q;
+    // Both polarisations averaged: ½·(c0 + 2·Σ A·q^m ...) summed over s and p.
+    float w1 = dot(amp, q);
+    float w2 = dot(amp, q2);
+    float w3 = dot(amp, q2 * q);
+    vec2 tail4 = amp * q2 * q2;  // A·q⁴ per polarisation
+    vec3 rgb = vec3(0.5 * (c0.x + c0.y));
+    for (int k = 0; k < 3; ++k) {
+        vec3 c1 = cos(TWO_PI * fract(u_film_sens_centre[k] * opd_um));
+        vec3 c2 = 2.0 * c1 * c1 - 1.0;
+        vec3 c3 = c1 * (2.0 * c2 - 1.0);
+        vec3 c4 = 2.0 * c2 * c2 - 1.0;
+        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um;
+        vec3 d1 = exp(-2.0 * sigma_opd * sigma_opd);
+        vec3 d4 = (d1 * d1) * (d1 * d1);
+        vec3 d9 = d4 * d4 * d1;
+        vec3 d16 = d4 * d4 * d4 * d4;
+        vec3 terms = w1 * c1 * d1 + w2 * c2 * d4 + w3 * c3 * d9;
+        vec3 tail = vec3(0.0);
+        for (int pol = 0; pol < 2; ++pol) {
+            float qp = q[pol];
+            vec3 den = max(1.0 - 2.0 * qp * c1 + qp * qp, 1e-12);
+            tail += tail4[pol] * (c4 - qp * c3) / den;
+        }
+        rgb += u_film_sens_weight[k] * (terms + d16 * tail);
+    }
     return max(rgb, vec3(0.0));
 }
 #endif
