@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import sys
 import time
@@ -188,7 +189,8 @@ def main() -> None:
             rows += measure(bench, name, args.quick)
         gl = bench.renderer.gl.describe()
         info = {"size": args.size, "gl": f"{gl['renderer']} ({gl['backend']})",
-                "date": time.strftime("%Y-%m-%d", time.gmtime())}
+                "date": time.strftime("%Y-%m-%d", time.gmtime()),
+                "load": f"{os.getloadavg()[1]:.1f} on {os.cpu_count()} cores"}
         write_atomic(results, json.dumps({"info": info, "rows": rows}, indent=2).encode())
     write_atomic(ROOT / "docs" / "model_trade.csv", to_csv(rows))
     write_atomic(ROOT / "docs" / "model_trade.md", to_markdown(rows, info).encode())

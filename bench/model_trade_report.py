@@ -36,7 +36,10 @@ def to_markdown(rows: list[dict], info: dict) -> str:
         "paper's model is rendered on the same scene at its reference tier, with the figure "
         "parameters of the paired paper preset and with mu_f, alpha, beta, theta1, theta2 and "
         "ks fitted by least squares to the ground truth (ks too, or brightness alone would "
-        "decide the fit). docs/physics.md explains the physical models.",
+        "decide the fit). docs/physics.md explains the physical models. Times are warm "
+        f"medians on a shared machine (5-minute load average {info.get('load', '?')} at the "
+        "end of the run): compare them within a preset, not across runs; the errors are "
+        "deterministic.",
         "",
         "| preset | model | setting | time (s) | ΔE00 object | ΔE00 streak / bands | FLIP |",
         "|---|---|---|---:|---:|---:|---:|",

@@ -177,3 +177,22 @@ def test_total_internal_reflection_reflects_everything(renderer, wavelengths):
     d = ref.mdf_ashikhmin(0.0, 0.0, 1.0, 10.0, 10.0)
     full = d / (4.0 * np.cos(angles) * np.cos(angles)) * np.cos(angles)  # R = 1, ks = 1
     assert np.allclose(gl, full[:, None], rtol=1e-4)
+
+
+@pytest.mark.parametrize("wavelengths", [0, 64])
+def test_shader_orders_land_where_the_grating_equation_puts_them(renderer, wavelengths):
+    """Views where the first order's λ = d·(l + v)·b is 450, 530 and 630 nm come out blue,
+    green and red in the shader, fast path and spectral alike: going away from the
+    specular, violet first."""
+    material = Material(iridescence="grating", ex=3e4, ey=3e4, grating_pitch=1.6,
+                        grating_orders=1)
+    targets = np.array([450.0, 530.0, 630.0])
+    s = targets / 1600.0
+    lb, vb = 0.5 * s - 0.3, 0.5 * s + 0.3
+    zeros = np.zeros_like(s)
+    l = np.stack([zeros, lb, np.sqrt(1 - lb * lb)], axis=1)
+    v = np.stack([zeros, vb, np.sqrt(1 - vb * vb)], axis=1)
+    n = np.tile([0.0, 0.0, 1.0], (3, 1))
+    t = np.tile([1.0, 0.0, 0.0], (3, 1))
+    gl = renderer.probe(material, n, t, l, v, wavelengths)
+    assert list(gl.argmax(axis=1)) == [2, 1, 0], gl
