@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING THICKNESS_MAP TRANSMISSION
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -58,6 +58,12 @@ uniform vec3 u_ambient;
 #ifdef NORMAL_MAP
 uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
 #endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
+uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickness texture
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
+uniform vec3 u_backdrop;  // linear radiance that displays as the background colour
+#endif
 
 out vec4 frag_color;
 
@@ -85,6 +91,10 @@ void main() {
     }
 #endif
     mat3 frame = shading_frame(n, t);
+#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
+    film_thickness = mix(u_film_thickness_min, u_film_thickness_max,
+                         texture(u_thickness_map, v_uv).r);
+#endif
     vec3 v = normalize(u_eye - v_world);
 
     vec3 radiance = vec3(0.0);
@@ -98,6 +108,13 @@ void main() {
     }
 #ifdef DIFFUSE
     radiance += u_ambient * u_kd * u_albedo;
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
+    // A free, lossless film transmits what it does not reflect: the backdrop seen
+    // through both walls, each met at the view's angle to the surface (the back
+    // wall's own thickness is not known: this one's is used).
+    vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm());
+    radiance += u_backdrop * through * through;
 #endif
     frag_color = vec4(radiance, 1.0);
 }

@@ -82,10 +82,13 @@ def test_every_file_loads():
         assert load_preset_file(path).name == path.stem
 
 
-def test_preset_names_are_the_eight_of_design():
-    """The presets are exactly the eight of docs/design.md §6."""
-    assert set(all_presets()) == set(PAPER)
-    assert len(all_presets()) == 8
+PHYSICAL = {"oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film"}
+
+
+def test_preset_names_are_the_eight_of_design_and_the_physical_ones():
+    """The presets are exactly the eight of docs/design.md §6 and the five physical ones (issue 14)."""
+    assert set(all_presets()) == set(PAPER) | PHYSICAL
+    assert len(all_presets()) == 13
 
 
 @pytest.mark.parametrize("name", sorted(PAPER))

@@ -141,6 +141,9 @@ def test_cache_key_stable_across_processes():
 CHANGED_MATERIAL = {
     "mdf": "ashikhmin", "ex": 101.0, "ey": 11.0, "mu_f": 8.6, "alpha": 2.1, "beta": 1.3,
     "theta1": 0.11, "theta2": 0.21, "kd": 0.3, "ks": 0.6, "albedo": (0.7, 0.7, 0.73), "f0": 0.9,
+    "iridescence": "thin-film", "film_ior": 1.4, "film_thickness_min": 120.0,
+    "film_thickness_max": 420.0, "substrate_ior": 1.33, "grating_pitch": 0.74,
+    "grating_orders": 2, "grating_depth": 120.0,
 }
 
 

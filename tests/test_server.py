@@ -20,7 +20,7 @@ TIMEOUT = httpx.Timeout(30.0, connect=5.0)
 @pytest.fixture(scope="module")
 def server(backend):
     env = {"OPALINE_GL_BACKEND": backend, "OPALINE_QUEUE_SIZE": str(QUEUE),
-           "OPALINE_DEADLINE_S": "5", "OPALINE_WARMUP": "false"}
+           "OPALINE_DEADLINE_S": "30", "OPALINE_WARMUP": "false"}
     try:
         with LocalServer(workers=1, env=env) as local:
             yield local.base, local.proc, local.log

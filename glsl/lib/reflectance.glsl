@@ -9,6 +9,11 @@
 #ifdef FRESNEL
 #include "lib/fresnel.glsl"
 #endif
+#if defined(IRIDESCENCE_THIN_FILM)
+#include "lib/thin_film.glsl"
+#elif defined(IRIDESCENCE_GRATING)
+#include "lib/grating.glsl"
+#endif
 
 uniform float u_ks;
 #ifdef DIFFUSE
@@ -17,6 +22,9 @@ uniform vec3 u_albedo;
 #endif
 
 vec3 specular(realmat3 frame, vec3 l, vec3 v) {
+#ifdef IRIDESCENCE_GRATING
+    return u_ks * grating_specular(frame, l, v);
+#else
     real3 sum_lv = real3(l) + real3(v);
     real len = length(sum_lv);
     // l = -v: no half vector, no specular.
@@ -25,8 +33,13 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v) {
     }
     real3 h = sum_lv / len;
     real3 hl = transpose(frame) * h;  // (h·t, h·b, h·n)
-    vec3 d = mdf_color(hl.xy, float(hl.z));
     float vh = float(dot(real3(v), h));
+#ifdef IRIDESCENCE_THIN_FILM
+    // The unrotated lobe, coloured by the film instead of by rotation (Fresnel off).
+    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z)) * film_rgb(vh, film_thickness_nm());
+#else
+    vec3 d = mdf_color(hl.xy, float(hl.z));
+#endif
     float nl = float(dot(frame[2], real3(l)));
     float nv = float(dot(frame[2], real3(v)));
 #ifdef FRESNEL
@@ -36,6 +49,7 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v) {
 #endif
     float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
     return u_ks * d * (f / denom);
+#endif
 }
 
 vec3 reflected_radiance(realmat3 frame, vec3 l, vec3 v) {

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from opaline.model.presets import Preset, build_assets
+from opaline.gl import physical
+from opaline.model.presets import Preset, build_assets, build_thickness
 
 TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
 
@@ -90,9 +91,11 @@ class SceneGPU:
             self.normal_map.build_mipmaps()
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.normal_map.repeat_x = self.normal_map.repeat_y = True
-        # Mipmaps add a third to the normal map.
-        self.nbytes = self.vbo.size + self.ibo.size + (
-            self.normal_map.width * self.normal_map.height * 12 * 4 // 3 if self.normal_map else 0)
+        self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset))
+        # Mipmaps add a third to a texture.
+        self.nbytes = self.vbo.size + self.ibo.size + sum(
+            tex.width * tex.height * tex.components * 4 * 4 // 3
+            for tex in (self.normal_map, self.thickness_map) if tex is not None)
         self._vaos: dict[int, moderngl.VertexArray] = {}
 
     def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
@@ -112,6 +115,6 @@ class SceneGPU:
     def release(self) -> None:
         for vao in self._vaos.values():
             vao.release()
-        for obj in (self.vbo, self.ibo, self.normal_map):
+        for obj in (self.vbo, self.ibo, self.normal_map, self.thickness_map):
             if obj is not None:
                 obj.release()

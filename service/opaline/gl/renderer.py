@@ -13,7 +13,7 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from opaline.gl import uniforms
+from opaline.gl import physical, uniforms
 from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
@@ -130,6 +130,10 @@ class Renderer(Probes):
         defines["NORMAL_MAP"] = preset.normal_map is not None
         defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
         defines["LIGHT_COUNT"] = len(preset.lights)
+        if physical.uses_thickness_map(job.material, preset):
+            defines["THICKNESS_MAP"] = True
+        if physical.uses_transmission(job.material, preset):
+            defines["TRANSMISSION"] = True
         return defines
 
     def _draw_samples(
@@ -174,6 +178,12 @@ class Renderer(Probes):
             values["u_normal_map"] = NORMAL_MAP_UNIT
             # Bound once: the accumulate pass between samples binds unit 0 only.
             normal_map.use(location=NORMAL_MAP_UNIT)
+        if defines.get("TRANSMISSION"):
+            values["u_backdrop"] = physical.backdrop_radiance(
+                preset.background, job.tonemap, job.exposure)
+        if defines.get("THICKNESS_MAP"):
+            values["u_thickness_map"] = physical.THICKNESS_UNIT
+            scene.thickness_map.use(location=physical.THICKNESS_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
         multi = len(offsets) > 1

@@ -7,6 +7,7 @@ import math
 import moderngl
 import numpy as np
 
+from opaline.gl import physical
 from opaline.model.params import Material
 from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
 
@@ -32,6 +33,7 @@ def material_defines(
         **mdf_defines(material, wavelengths, aa),
         "DIFFUSE": material.kd > 0.0 and max(material.albedo) > 0.0,
         "FRESNEL": material.f0 < 1.0,
+        **physical.defines(material),
     }
 
 
@@ -57,6 +59,7 @@ def material_uniforms(material: Material, wavelengths: int = 0) -> dict[str, obj
         values["u_spectral_weight"] = [tuple(w) for w in rgb_weights(wavelengths)]
     else:
         values["u_rotation"] = _cos_sin(np.array([0.0, material.theta1, material.theta2]))
+    values.update(physical.uniforms(material, wavelengths))
     return values
 
 

@@ -16,6 +16,7 @@ from opaline.model import messages
 
 # Re-exported: the CLI and the API read a field's range next to the models.
 from opaline.model.messages import field_range as field_range
+from opaline.model.physical_params import PhysicalFields, PhysicalMaterial
 
 TWO_PI = 2.0 * math.pi
 
@@ -42,7 +43,7 @@ def wavelengths_ok(value: int | None) -> int | None:
     return value
 
 
-class MaterialFields(BaseModel):
+class MaterialFields(PhysicalFields):
     """Material parameters; ``None`` means "take the preset's value"."""
 
     model_config = STRICT
@@ -136,7 +137,7 @@ class RenderRequest(RenderFields):
     preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
 
 
-class Material(BaseModel):
+class Material(PhysicalMaterial):
     """A fully specified material, as the renderer consumes it."""
 
     model_config = STRICT

@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from opaline.model.params import STRICT, RenderFields, Unit, describe_errors
 from opaline.resources import presets_dir
-from opaline.scene import geometry, normalmaps
+from opaline.scene import geometry, normalmaps, thickness
 
 Vec3 = tuple[float, float, float]
 NonNegative3 = tuple[
@@ -69,6 +69,10 @@ class Preset(BaseModel):
     geometry: Generator
     tangents: Literal["uv", "concentric"] = "uv"
     normal_map: Generator | None = None
+    # Film thickness in [0, 1] over uv, mapped to [film_thickness_min, max] (thin film only).
+    thickness_map: Generator | None = None
+    # A free film (soap bubble): the background shows through what the film does not reflect.
+    transmission: bool = False
     rotation_deg: Vec3 = (0.0, 0.0, 0.0)
     camera: Camera
     lights: Annotated[list[Light], Field(min_length=1, max_length=8)]
@@ -100,6 +104,7 @@ def load_preset_file(path: Path) -> Preset:
 def _check_generators(filename: str, preset: Preset) -> None:
     try:
         build_assets(preset)
+        build_thickness(preset)
     except ValueError as exc:
         raise PresetError(f"preset {filename}: {exc}") from exc
 
@@ -120,6 +125,23 @@ def build_assets(preset: Preset) -> tuple[Any, Any]:
             normal_map = normalmaps.build(preset.normal_map.kind, **args)
         _assets[key] = (mesh, normal_map)
     return _assets[key]
+
+
+_thickness: dict[str, Any] = {}
+
+
+def build_thickness(preset: Preset) -> Any:
+    """The preset's film-thickness field (or None), generated once per scene."""
+    key = preset.scene_key()
+    if key not in _thickness:
+        field = None
+        if preset.thickness_map is not None:
+            args = preset.thickness_map.args
+            if preset.thickness_map.kind == "file":
+                args["path"] = str(presets_dir() / args.get("path", ""))
+            field = thickness.build(preset.thickness_map.kind, **args)
+        _thickness[key] = field
+    return _thickness[key]
 
 
 @cache

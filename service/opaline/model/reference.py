@@ -11,10 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from opaline.model.microfacet import (  # noqa: F401 (re-exported: the reference in one place)
+    EPS_DENOM,
+    EPS_HALF,
+    fresnel_schlick,
+    log1p_ratio,
+    mdf_ashikhmin,
+)
 from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
 
-EPS_DENOM = 1e-4  # docs/design.md §2: every denominator clamped to at least this
-EPS_HALF = 1e-6  # |l + v| below this: no half vector, no specular
 TWO_PI = 2.0 * np.pi
 
 
@@ -22,27 +27,6 @@ def rotate_half(hx, hy, theta):
     """Eq. 2: rotate the projected half vector counter-clockwise by ``theta``."""
     c, s = np.cos(theta), np.sin(theta)
     return c * hx - s * hy, s * hx + c * hy
-
-
-def log1p_ratio(s2):
-    """-log1p(-s2) / s2, which is 1 at s2 = 0 and grows to the rim.
-
-    ``hz**e = exp(e * ln hz)`` with ``ln hz = 0.5 * log1p(-s2)``; dividing by s2
-    here lets the A-S exponent be written from hx², hy² alone (docs/design.md §2).
-    """
-    s2 = np.asarray(s2, dtype=np.float64)
-    u = np.clip(1.0 - s2, 1e-12, 1.0)
-    safe = np.where(s2 > 0.0, s2, 1.0)
-    return np.where(s2 > 0.0, -np.log(u) / safe, 1.0)
-
-
-def mdf_ashikhmin(hx, hy, hz, ex, ey):
-    """Eq. 1: sqrt((ex+1)(ey+1))/(2π) · hz^((ex·hx² + ey·hy²)/(hx² + hy²))."""
-    hx2, hy2 = hx * hx, hy * hy
-    s2 = np.minimum(hx2 + hy2, 1.0)
-    log_term = -0.5 * (ex * hx2 + ey * hy2) * log1p_ratio(s2)
-    norm = np.sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI
-    return np.where(hz > 0.0, norm * np.exp(log_term), 0.0)
 
 
 def mdf_multipeak(hx, hy, hz, mu_f, alpha, beta):
@@ -91,11 +75,6 @@ def mdf_rgb(material, hx, hy, hz, wavelengths=0):
     return np.stack(out, axis=-1)
 
 
-def fresnel_schlick(f0, cos_theta):
-    cos_theta = np.clip(cos_theta, 0.0, 1.0)
-    return f0 + (1.0 - f0) * (1.0 - cos_theta) ** 5
-
-
 def normalize(v):
     length = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.maximum(length, 1e-30)
@@ -125,6 +104,11 @@ def specular_rgb(material, n, t, l, v, wavelengths=0):
 def specular(material, frame, l, v, wavelengths=0):
     """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel in a (t, b, n) frame; zero where h is
     undefined."""
+    if getattr(material, "iridescence", "rotation") != "rotation":
+        # Imported here: the physical sources build on this module's functions.
+        from opaline.model import physical
+
+        return physical.specular(material, frame, l, v, wavelengths)
     t, b, n = frame
     sum_lv = l + v
     length = np.linalg.norm(sum_lv, axis=-1, keepdims=True)

@@ -23,15 +23,23 @@
   const GROUPS = [
     ['material', 'Material', ['mdf', 'ex', 'ey', 'mu_f', 'alpha', 'beta', 'theta1', 'theta2',
       'kd', 'ks', 'albedo', 'f0']],
+    ['physical', 'Iridescence source', ['iridescence', 'film_ior', 'film_thickness_min',
+      'film_thickness_max', 'substrate_ior', 'grating_pitch', 'grating_orders', 'grating_depth']],
     ['light', 'Light', ['light_azimuth', 'light_elevation']],
     ['output', 'Output', ['width', 'height', 'quality', 'format', 'exposure', 'tonemap',
       'transparent']],
     ['tier', 'Quality tier overrides', ['samples', 'wavelengths', 'aa']],
   ];
-  const MATERIAL = new Set(GROUPS[0][2]);
+  const MATERIAL = new Set([...GROUPS[0][2], ...GROUPS[1][2]]);
   // Which MDF reads which parameter (docs/design.md §1); the others are dimmed.
   const MDF_ONLY = { ex: 'ashikhmin', ey: 'ashikhmin', mu_f: 'multipeak', alpha: 'multipeak',
     beta: 'multipeak' };
+  // Which iridescence source reads which field (docs/physics.md); the physical
+  // sources use the A-S lobe (ex, ey) and none of the paper's rotation fields.
+  const SOURCE_ONLY = { film_ior: 'thin-film', film_thickness_min: 'thin-film',
+    film_thickness_max: 'thin-film', substrate_ior: 'thin-film', grating_pitch: 'grating',
+    grating_orders: 'grating', grating_depth: 'grating' };
+  const PAPER_ONLY = ['mdf', 'mu_f', 'alpha', 'beta', 'theta1', 'theta2'];
   // The MDF plot shows D only: these are the material fields it reads.
   const MDF_PLOT_FIELDS = ['mdf', 'ex', 'ey', 'mu_f', 'alpha', 'beta', 'theta1', 'theta2'];
   // Unset = the quality tier's value (which changes with the tier).
@@ -207,7 +215,7 @@
     if (value === null || value === '' || same(value, defaultOf(name))) delete state.overrides[name];
     else state.overrides[name] = value;
     refreshField(name, source);
-    if (name === 'mdf') refreshInactive();
+    if (name === 'mdf' || name === 'iridescence') refreshInactive();
     schedule();
   }
 
@@ -413,12 +421,18 @@
 
   function refreshInactive() {
     const mdf = valueOf('mdf');
-    for (const [name, owner] of Object.entries(MDF_ONLY)) {
+    const source = valueOf('iridescence') ?? 'rotation';
+    const mark = (name, unused, by) => {
       const control = state.controls.get(name);
-      if (!control) continue;
-      const unused = mdf !== owner;
+      if (!control) return;
       control.wrap.classList.toggle('inactive', unused);
-      control.wrap.querySelector('.note').textContent = unused ? `unused by ${mdf}` : '';
+      control.wrap.querySelector('.note').textContent = unused ? `unused by ${by}` : '';
+    };
+    for (const [name, owner] of Object.entries(MDF_ONLY)) mark(name, mdf !== owner, mdf);
+    for (const [name, owner] of Object.entries(SOURCE_ONLY)) mark(name, source !== owner, source);
+    if (source !== 'rotation') {
+      for (const name of PAPER_ONLY) mark(name, true, source);
+      for (const name of ['ex', 'ey']) mark(name, false, source);
     }
   }
 

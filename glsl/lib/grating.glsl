@@ -1,0 +1,135 @@
+// Grating colour (docs/physics.md §2): a 1-D reflection grating with grooves along
+// the tangent t and grating vector along the bitangent b. Order m at wavelength λ
+// is the A-S lobe at h_m = k_m/|k_m|, k_m = l + v - (m·λ/d)·b, weighted by
+//   η_m(λ)·F(v·h_m)·(v·h_m) / (|k_m|²·max(n·l, n·v))
+// (dω_h/dω_v = (v·h_m)/|k_m|²; for m = 0 this is the usual 1/(4 v·h)), with
+// η_m = J_m(a)², a = π·depth·(n·(l+v))/λ, a sinusoidal phase grating's efficiency.
+// Float64 twin: opaline/model/grating.py.
+#ifndef GRATING_GLSL
+#define GRATING_GLSL
+#include "lib/common.glsl"
+#include "lib/material.glsl"
+#ifdef FRESNEL
+#include "lib/fresnel.glsl"
+#endif
+
+#define GRATING_MAX_ORDERS 8
+#define BESSEL_TERMS 24
+#define EPS_K2 1e-12
+
+uniform float u_grating_pitch_nm;
+uniform float u_grating_depth_nm;
+uniform int u_grating_orders;
+
+// J_m(x) by its power series; fp32 loses < 1e-5 absolute for x ≤ 7 (depth ≤ 400 nm).
+float bessel_j(int m, float x) {
+    float half_x = 0.5 * x;
+    float term = 1.0;
+    for (int j = 1; j <= m; ++j) {
+        term *= half_x / float(j);
+    }
+    float total = term;
+    float q = -half_x * half_x;
+    for (int k = 1; k < BESSEL_TERMS; ++k) {
+        term *= q / float(k * (k + m));
+        total += term;
+    }
+    return total;
+}
+
+float grating_efficiency(int m, float lam, float kn) {
+    float j = bessel_j(abs(m), PI * u_grating_depth_nm * max(kn, 0.0) / lam);
+    return j * j;
+}
+
+// One order's lobe without η: k = (l+v) in the frame with its b component kb.
+float order_lobe(vec3 k, vec3 vl, float cos_max) {
+    float k2 = max(dot(k, k), EPS_K2);
+    float k_len = sqrt(k2);
+    vec3 h = k / k_len;
+    float vh = dot(vl, h);
+#ifdef FRESNEL
+    float f = fresnel_schlick(vh);
+#else
+    float f = 1.0;
+#endif
+    return f * mdf_ashikhmin(h.xy, h.z) * max(vh, 0.0) / (k2 * cos_max);
+}
+
+#if WAVELENGTHS > 0
+uniform float u_wavelength_nm[WAVELENGTHS];
+
+// Σ_i w_i Σ_{|m| ≤ M} η_m(λ_i)·lobe_m(λ_i).
+vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        float lam = u_wavelength_nm[i];
+        float step_b = lam / u_grating_pitch_nm;
+        float s = 0.0;
+        for (int m = -GRATING_MAX_ORDERS; m <= GRATING_MAX_ORDERS; ++m) {
+            if (abs(m) > u_grating_orders) {
+                continue;
+            }
+            vec3 km = vec3(k.x, k.y - float(m) * step_b, k.z);
+            s += grating_efficiency(m, lam, k.z) * order_lobe(km, vl, cos_max);
+        }
+        sum += u_spectral_weight[i] * s;
+    }
+    return max(sum, vec3(0.0));
+}
+#else
+// Fast path: each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999),
+// the lobe's extent in λ integrated under a Gaussian approximation across the
+// grooves: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey).
+#define VISIBLE_TABLE 81
+uniform vec3 u_visible_density[VISIBLE_TABLE];  // ŵ(λ) per nm, 380 … 780 nm by 5 nm
+uniform vec3 u_channel_nm;                       // where η_0 is taken per channel
+
+vec3 visible_density(float lam) {
+    float x = (lam - 380.0) / 5.0;
+    if (!(x >= 0.0 && x <= float(VISIBLE_TABLE - 1))) {
+        return vec3(0.0);
+    }
+    int i = min(int(floor(x)), VISIBLE_TABLE - 2);
+    return mix(u_visible_density[i], u_visible_density[i + 1], x - float(i));
+}
+
+vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+    vec3 k0 = vec3(k.x, 0.0, k.z);
+    float base = order_lobe(k0, vl, cos_max);
+    float k0_len = sqrt(max(dot(k0, k0), EPS_K2));
+    float width = sqrt(TWO_PI / max(u_ey, 1.0));
+    vec3 sum = vec3(0.0);
+    for (int m = 1; m <= GRATING_MAX_ORDERS; ++m) {
+        if (m > u_grating_orders) {
+            break;
+        }
+        float spread = u_grating_pitch_nm / float(m) * k0_len * width;
+        for (int sign = -1; sign <= 1; sign += 2) {
+            float lam = float(sign) * u_grating_pitch_nm * k.y / float(m);
+            vec3 density = visible_density(lam);
+            // Outside the visible range the order has no colour (and the Bessel
+            // series would overflow float at the huge a of a tiny λ).
+            if (density == vec3(0.0)) {
+                continue;
+            }
+            sum += density * (spread * grating_efficiency(m, lam, k.z) * base);
+        }
+    }
+    float zero = order_lobe(k, vl, cos_max);
+    vec3 eta0 = vec3(grating_efficiency(0, u_channel_nm.r, k.z),
+                     grating_efficiency(0, u_channel_nm.g, k.z),
+                     grating_efficiency(0, u_channel_nm.b, k.z));
+    return max(sum + zero * eta0, vec3(0.0));
+}
+#endif
+
+vec3 grating_specular(realmat3 frame, vec3 l, vec3 v) {
+    vec3 k = vec3(transpose(frame) * (real3(l) + real3(v)));  // (·t, ·b, ·n)
+    vec3 vl = vec3(transpose(frame) * real3(v));
+    float nl = float(dot(frame[2], real3(l)));
+    float cos_max = max(max(nl, vl.z), EPS_DENOM);
+    return grating_color(k, vl, cos_max);
+}
+
+#endif

@@ -1,0 +1,133 @@
+// Thin-film colour (docs/physics.md §1): Airy reflectance of a film of index
+// u_film_ior and thickness d (nm) on a substrate of index u_substrate_ior, under
+// air, at cos θ1 = v·h. Real indices make the Fresnel amplitudes a = r12 and
+// b = r23 real and signed (the sign is the interface's 0 or π phase shift):
+//   R(φ) = (a² + b² + 2ab·cos φ) / (1 + a²b² + 2ab·cos φ),  φ = 4π·n·d·cos θ2/λ,
+// averaged over s and p; total internal reflection gives 1. Float64 twin:
+// opaline/model/thinfilm.py.
+#ifndef THIN_FILM_GLSL
+#define THIN_FILM_GLSL
+#include "lib/common.glsl"
+#include "lib/material.glsl"
+
+uniform float u_film_ior;
+uniform float u_substrate_ior;
+uniform float u_film_thickness_min;
+uniform float u_film_thickness_max;
+
+// This fragment's thickness in nm, set by the surface from its thickness field;
+// negative (the probe, a surface without a field) means the maximum, as in KHR.
+float film_thickness = -1.0;
+
+float film_thickness_nm() {
+    return film_thickness >= 0.0 ? film_thickness : u_film_thickness_max;
+}
+
+float film_ratio(float num, float den) {
+    return num / (abs(den) > 1e-30 ? den : 1e-30);
+}
+
+// Both interfaces for s (.x) and p (.y); false where light cannot get through.
+bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    float nf = u_film_ior;
+    float ns = u_substrate_ior;
+    // cos²θ2 = 1 - sin²θ1/n² as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1 rounds
+    // to 1 in float, which would turn a film of index 1 into total reflection.
+    float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
+    float cos3_sq = (ns * ns - 1.0 + cos1 * cos1) / (ns * ns);
+    cos2 = sqrt(max(cos2_sq, 0.0));
+    float cos3 = sqrt(max(cos3_sq, 0.0));
+    r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
+               film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
+    r23 = vec2(film_ratio(nf * cos2 - ns * cos3, nf * cos2 + ns * cos3),
+               film_ratio(ns * cos2 - nf * cos3, ns * cos2 + nf * cos3));
+    return cos2_sq > 0.0 && cos3_sq > 0.0;
+}
+
+#if WAVELENGTHS > 0
+uniform float u_wavelength_nm[WAVELENGTHS];
+
+float film_airy(float a, float b, float c) {
+    float ab = a * b;
+    // The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
+    return max(a * a + b * b + 2.0 * ab * c, 0.0) / max(1.0 + ab * ab + 2.0 * ab * c, 1e-30);
+}
+
+// Σ_i w_i·R(λ_i), with the CIE weights of the spectral path (material.glsl).
+vec3 film_rgb(float cos1, float d) {
+    float cos2;
+    vec2 r12, r23;
+    if (!film_interfaces(cos1, cos2, r12, r23)) {
+        return vec3(1.0);
+    }
+    float opd = 2.0 * u_film_ior * d * cos2;  // nm
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        // φ in cycles, reduced before the cosine: float trig never sees a big argument.
+        float cycles = opd / u_wavelength_nm[i];
+        float c = cos(TWO_PI * fract(cycles));
+        float r = 0.5 * (film_airy(r12.x, r23.x, c) + film_airy(r12.y, r23.y, c));
+        sum += u_spectral_weight[i] * r;
+    }
+    return max(sum, vec3(0.0));
+}
+#else
+// Fast path (Belcour & Barla 2017): R(φ) = c0 + 2·Σ_m c_m cos(mφ) with
+// c0 = (a² + b² - 2x²)/(1 - x²), c_m = A·q^m, A = -(1-a²)(1-b²)/(1-x²), q = -x,
+// x = ab; each cos(mφ) integrated against the colour weights in closed form from
+// three Gaussians per channel over wavenumber (opaline/model/visible.py):
+//   ∫ ŵ cos(2π·m·opd·ν) dν = Σ_k w_k cos(m·θ_k) d_k^(m²),  θ_k = 2π·μ_k·opd,
+//   d_k = exp(-2(π·σ_k·opd)²).
+// The three terms are evaluated from one cosine and one exponential per Gaussian
+// (Chebyshev for cos mθ, powers for d^(m²)), shared by s and p; the terms m > 3,
+// which matter near grazing where |q| nears 1, are summed as the geometric series
+// Re(z⁴/(1 - z)), z = q·e^{iθ}, damped as the term m = 4. The float64 twin
+// (model/thinfilm.py) evaluates the same sums term by term.
+uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
+uniform vec3 u_film_sens_centre[3];  // µm⁻¹
+uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
+
+vec3 film_rgb(float cos1, float d) {
+    float cos2;
+    vec2 r12, r23;
+    if (!film_interfaces(cos1, cos2, r12, r23)) {
+        return vec3(1.0);
+    }
+    float opd_um = 2e-3 * u_film_ior * d * cos2;
+    vec2 x = r12 * r23;  // (s, p)
+    vec2 one_minus = max(1.0 - x * x, 1e-30);
+    vec2 c0 = (r12 * r12 + r23 * r23 - 2.0 * x * x) / one_minus;
+    vec2 amp = -(1.0 - r12 * r12) * (1.0 - r23 * r23) / one_minus;
+    vec2 q = -x;
+    vec2 q2 = q * q;
+    // Both polarisations averaged: ½·(c0 + 2·Σ A·q^m ...) summed over s and p.
+    float w1 = dot(amp, q);
+    float w2 = dot(amp, q2);
+    float w3 = dot(amp, q2 * q);
+    vec2 tail4 = amp * q2 * q2;  // A·q⁴ per polarisation
+    vec3 rgb = vec3(0.5 * (c0.x + c0.y));
+    for (int k = 0; k < 3; ++k) {
+        vec3 c1 = cos(TWO_PI * fract(u_film_sens_centre[k] * opd_um));
+        vec3 c2 = 2.0 * c1 * c1 - 1.0;
+        vec3 c3 = c1 * (2.0 * c2 - 1.0);
+        vec3 c4 = 2.0 * c2 * c2 - 1.0;
+        vec3 sigma_opd = PI * u_film_sens_sigma[k] * opd_um;
+        vec3 d1 = exp(-2.0 * sigma_opd * sigma_opd);
+        vec3 d4 = (d1 * d1) * (d1 * d1);
+        vec3 d9 = d4 * d4 * d1;
+        vec3 d16 = d4 * d4 * d4 * d4;
+        vec3 terms = w1 * c1 * d1 + w2 * c2 * d4 + w3 * c3 * d9;
+        vec3 tail = vec3(0.0);
+        for (int pol = 0; pol < 2; ++pol) {
+            float qp = q[pol];
+            vec3 den = max(1.0 - 2.0 * qp * c1 + qp * qp, 1e-12);
+            tail += tail4[pol] * (c4 - qp * c3) / den;
+        }
+        rgb += u_film_sens_weight[k] * (terms + d16 * tail);
+    }
+    return max(rgb, vec3(0.0));
+}
+#endif
+
+#endif

@@ -1,0 +1,130 @@
+"""Float64 reference of the grating source (docs/physics.md §2).
+
+A 1-D reflection grating: grooves along the tangent t, grating vector along the
+bitangent b, pitch d. Order m at wavelength λ leaves where the tangential
+momentum matches, (l + v)·b = m·λ/d and (l + v)·t = 0. Its lobe is the
+Ashikhmin-Shirley MDF at the direction of the shifted sum
+
+    k_m = l + v - (m·λ/d)·b,        h_m = k_m / |k_m|
+
+(for m = 0 the ordinary half vector), so every order has the roughness (ex, ey)
+of the specular highlight. With dω_h/dω_v = (v·h_m)/|k_m|² (for m = 0 this is
+the familiar 1/(4 v·h)) the order contributes
+
+    ks · η_m(λ) · F(v·h_m) · D(h_m) · (v·h_m) / (|k_m|² · max(n·l, n·v)).
+
+Efficiency: a sinusoidal groove of depth δ is a thin phase grating of phase
+amplitude a = π·δ·(n·(l + v))/λ, whose orders carry η_m = J_m(a)² (Σ_m η_m = 1).
+Each function mirrors the GLSL function of the same name in glsl/lib/grating.glsl.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from opaline.model import visible
+from opaline.model.microfacet import EPS_DENOM, fresnel_schlick, mdf_ashikhmin
+from opaline.model.spectrum import rgb_weights, sample_wavelengths
+
+BESSEL_TERMS = 24  # series terms: below 1e-9 of the sum for a ≤ 7 (depth ≤ 400 nm)
+EPS_K2 = 1e-12
+
+
+def bessel_j(m: int, x):
+    """J_m(x) from its power series Σ_k (-1)^k (x/2)^(2k+m) / (k!(k+m)!), as the shader does."""
+    x = np.asarray(x, dtype=np.float64)
+    half = 0.5 * x
+    term = half**m / math.factorial(m)
+    total = term
+    q = -half * half
+    for k in range(1, BESSEL_TERMS):
+        term = term * q / (k * (k + m))
+        total = total + term
+    return total
+
+
+def efficiency(m: int, lam_nm, depth_nm, kn):
+    """η_m = J_|m|(a)², a = π·depth·(n·(l+v))/λ."""
+    return bessel_j(abs(m), np.pi * depth_nm * kn / lam_nm) ** 2
+
+
+def _local(frame, x):
+    t, b, n = frame
+    return np.sum(x * t, axis=-1), np.sum(x * b, axis=-1), np.sum(x * n, axis=-1)
+
+
+def order_lobe(material, frame, l, v, m: int, lam_nm):
+    """One order's lobe at one wavelength, without ks and η: F·D(h_m)·(v·h_m)/(|k_m|²·max(n·l, n·v))."""
+    kt, kb, kn = _local(frame, l + v)
+    vt, vb, vn = _local(frame, v)
+    ln = _local(frame, l)[2]
+    kb = kb - m * lam_nm / (1000.0 * material.grating_pitch)
+    k2 = np.maximum(kt * kt + kb * kb + kn * kn, EPS_K2)
+    k_len = np.sqrt(k2)
+    d = mdf_ashikhmin(kt / k_len, kb / k_len, kn / k_len, material.ex, material.ey)
+    vh = (vt * kt + vb * kb + vn * kn) / k_len
+    f = fresnel_schlick(material.f0, vh)
+    return f * d * np.maximum(vh, 0.0) / (k2 * np.maximum(np.maximum(ln, vn), EPS_DENOM))
+
+
+def order_term(material, frame, l, v, m: int, lam_nm):
+    """η_m(λ) times the order's lobe."""
+    kn = np.maximum(_local(frame, l + v)[2], 0.0)
+    eta = efficiency(m, lam_nm, material.grating_depth, kn)
+    return eta * order_lobe(material, frame, l, v, m, lam_nm)
+
+
+def grating_spectral(material, frame, l, v, wavelengths):
+    """Σ_i w_i Σ_{|m| ≤ M} term(m, λ_i): per-wavelength, integrated to linear sRGB."""
+    lam = sample_wavelengths(wavelengths)
+    weights = rgb_weights(wavelengths)
+    orders = material.grating_orders
+    total = 0.0
+    for lam_i, w in zip(lam, weights, strict=True):
+        s = sum(order_term(material, frame, l, v, m, lam_i) for m in range(-orders, orders + 1))
+        total = total + s[..., None] * w
+    return np.maximum(total, 0.0)
+
+
+def channel_wavelengths() -> np.ndarray:
+    """Centroid of each channel's weight (nm): where the fast path evaluates η_0."""
+    grid, table = visible.density_table()
+    return np.sum(grid[:, None] * table, axis=0) / np.sum(table, axis=0)
+
+
+def grating_fast(material, frame, l, v):
+    """Each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999's idea).
+
+    The lobe's extent in λ is integrated in closed form under a Gaussian
+    approximation of the A-S lobe across the grooves, exp(-ey·h_b²/2), with the
+    colour weight taken constant over it: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey).
+    Right for lobes narrower than the visible range (ey ≳ 1e3 on a CD)."""
+    kt, kb, kn = _local(frame, l + v)
+    vt, _, vn = _local(frame, v)
+    ln = _local(frame, l)[2]
+    pitch_nm = 1000.0 * material.grating_pitch
+    k0_sq = np.maximum(kt * kt + kn * kn, EPS_K2)
+    k0 = np.sqrt(k0_sq)
+    d0 = mdf_ashikhmin(kt / k0, 0.0 * kt, kn / k0, material.ex, material.ey)
+    vh0 = (vt * kt + vn * kn) / k0
+    base = fresnel_schlick(material.f0, vh0) * d0 * np.maximum(vh0, 0.0)
+    base = base / (k0_sq * np.maximum(np.maximum(ln, vn), EPS_DENOM))
+    kn_pos = np.maximum(kn, 0.0)
+    total = 0.0
+    for m in range(1, material.grating_orders + 1):
+        for sign in (1, -1):
+            lam = sign * pitch_nm * kb / m
+            spread = (pitch_nm / m) * k0 * math.sqrt(2.0 * math.pi / max(material.ey, 1.0))
+            density = visible.density_at(lam)
+            # Outside the visible range: no colour, and no Bessel series at a huge a.
+            eta = efficiency(m, np.where(np.any(density != 0.0, axis=-1), lam, 550.0),
+                             material.grating_depth, kn_pos)
+            total = total + density * (spread * eta * base)[..., None]
+    zero = order_lobe(material, frame, l, v, 0, 550.0)  # m = 0: k does not depend on λ
+    eta0 = np.stack(
+        [efficiency(0, lam_c, material.grating_depth, kn_pos) for lam_c in channel_wavelengths()],
+        axis=-1,
+    )
+    return np.maximum(total + zero[..., None] * eta0, 0.0)

@@ -1,0 +1,125 @@
+"""Float64 reference of the thin-film source (docs/physics.md §1).
+
+A film of index ``n_film`` and thickness ``d`` (nm) on a substrate of index
+``n_sub``, under air. Light meets it at cos θ1 = v·h (the facet's normal is the
+half vector); inside the film cos θ2 follows from Snell. With real indices the
+Fresnel amplitude coefficients a = r12, b = r23 are real and signed (their
+sign is the interface's 0 or π phase shift), and Airy's sum of the multiply
+reflected waves gives, per polarisation,
+
+    R(φ) = (a² + b² + 2ab·cos φ) / (1 + a²b² + 2ab·cos φ),   φ = 4π·n_film·d·cos θ2 / λ
+
+averaged over s and p (unpolarised light). Total internal reflection at
+either interface gives R = 1. Each function mirrors the GLSL function of the
+same name in glsl/lib/thin_film.glsl.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from opaline.model import visible
+from opaline.model.spectrum import rgb_weights, sample_wavelengths
+
+FAST_TERMS = 3  # Fourier terms of the fast path; |ab|^4 < 1e-3 below grazing
+
+
+def interfaces(cos1, n_film, n_sub):
+    """(cos θ2, r12 s/p, r23 s/p, tir): Fresnel amplitudes at both interfaces."""
+    cos1 = np.clip(np.asarray(cos1, dtype=np.float64), 0.0, 1.0)
+    # cos²θ2 = 1 - sin²θ1/n² written as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1
+    # rounds to 1 in fp32, which would turn a film of index 1 into total reflection.
+    cos1_sq = cos1 * cos1
+    cos2_sq = (n_film * n_film - 1.0 + cos1_sq) / (n_film * n_film)
+    cos3_sq = (n_sub * n_sub - 1.0 + cos1_sq) / (n_sub * n_sub)
+    tir = (cos2_sq <= 0.0) | (cos3_sq <= 0.0)
+    cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
+    cos3 = np.sqrt(np.maximum(cos3_sq, 0.0))
+    r12s = _ratio(cos1 - n_film * cos2, cos1 + n_film * cos2)
+    r12p = _ratio(n_film * cos1 - cos2, n_film * cos1 + cos2)
+    r23s = _ratio(n_film * cos2 - n_sub * cos3, n_film * cos2 + n_sub * cos3)
+    r23p = _ratio(n_sub * cos2 - n_film * cos3, n_sub * cos2 + n_film * cos3)
+    return cos2, (r12s, r12p), (r23s, r23p), tir
+
+
+def _ratio(num, den):
+    return num / np.where(np.abs(den) > 1e-30, den, 1e-30)
+
+
+def airy(a, b, phase):
+    """Reflectance of one polarisation: |a + b·e^{iφ}|² / |1 + ab·e^{iφ}|²."""
+    ab = a * b
+    c = np.cos(phase)
+    # The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
+    num = np.maximum(a * a + b * b + 2.0 * ab * c, 0.0)
+    return num / np.maximum(1.0 + ab * ab + 2.0 * ab * c, 1e-30)
+
+
+def film_reflectance(cos1, lam_nm, d_nm, n_film, n_sub):
+    """Airy reflectance averaged over s and p at wavelength ``lam_nm`` (broadcasts)."""
+    cos2, (r12s, r12p), (r23s, r23p), tir = interfaces(cos1, n_film, n_sub)
+    phase = 4.0 * np.pi * n_film * d_nm * cos2 / lam_nm
+    r = 0.5 * (airy(r12s, r23s, phase) + airy(r12p, r23p, phase))
+    return np.where(tir, 1.0, r)
+
+
+def film_rgb_spectral(cos1, d_nm, n_film, n_sub, wavelengths):
+    """Σ_i w_i·R(λ_i): ``wavelengths`` bins over 380-780 nm, CIE 1931 to linear sRGB."""
+    cos1 = np.asarray(cos1, dtype=np.float64)
+    lam = sample_wavelengths(wavelengths)
+    weights = rgb_weights(wavelengths)
+    r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub)
+    return np.maximum(r @ weights, 0.0)
+
+
+def film_rgb_fast(cos1, d_nm, n_film, n_sub):
+    """Belcour & Barla 2017's evaluation: R(φ) as a Fourier series in φ, each term
+    integrated against the colour weights in closed form (``visible.sensitivity``).
+
+    For real a, b: R = c0 + 2·Σ_m c_m·cos(mφ), c0 = (a² + b² - 2x²)/(1 - x²),
+    c_m = -(1 - a²)(1 - b²)/(1 - x²)·(-x)^m with x = ab. The sign of (-x)^m is a
+    phase shift of π per order where x > 0. The first FAST_TERMS terms are
+    integrated exactly; the rest (which matter near grazing, where |x| nears 1
+    and a thin film must still come out as its bare substrate) are summed as a
+    geometric series per Gaussian with the damping of the first omitted term."""
+    cos1 = np.asarray(cos1, dtype=np.float64)
+    cos2, r12, r23, tir = interfaces(cos1, n_film, n_sub)
+    opd_um = 2e-3 * n_film * np.asarray(d_nm, dtype=np.float64) * cos2
+    total = 0.0
+    for a, b in zip(r12, r23, strict=True):
+        x = a * b
+        one_minus = np.maximum(1.0 - x * x, 1e-30)
+        c0 = (a * a + b * b - 2.0 * x * x) / one_minus
+        amp = -(1.0 - a * a) * (1.0 - b * b) / one_minus
+        shift = np.where(x > 0.0, np.pi, 0.0)
+        rgb = c0[..., None]
+        for m in range(1, FAST_TERMS + 1):
+            term = amp * np.abs(x) ** m
+            rgb = rgb + 2.0 * term[..., None] * visible.sensitivity(m * opd_um, m * shift)
+        rgb = rgb + 2.0 * amp[..., None] * film_tail(np.abs(x), opd_um, shift)
+        total = total + 0.5 * rgb
+    return np.maximum(np.where(tir[..., None], 1.0, total), 0.0)
+
+
+def film_tail(x_abs, opd_um, shift):
+    """Σ_{m > M} |x|^m·∫ ŵ cos(m(2π·opd·ν + shift)) dν, each Gaussian at its centre:
+    Re(z^(M+1)/(1 - z)) with z = |x|·e^{iθ}, damped as the term m = M + 1."""
+    g = visible.sensitivity_gaussians()
+    big_m = FAST_TERMS
+    x = np.asarray(x_abs)[..., None]
+    opd = np.asarray(opd_um)[..., None]
+    total = 0.0
+    for k in range(g.shape[0]):
+        weight, centre, sigma = g[k, :, 0], g[k, :, 1], g[k, :, 2]
+        theta = 2.0 * np.pi * centre * opd + np.asarray(shift)[..., None]
+        damp = np.exp(-2.0 * (np.pi * sigma * opd * (big_m + 1)) ** 2)
+        num = x ** (big_m + 1) * np.cos((big_m + 1) * theta) - x ** (big_m + 2) * np.cos(big_m * theta)
+        den = np.maximum(1.0 - 2.0 * x * np.cos(theta) + x * x, 1e-12)
+        total = total + weight * damp * num / den
+    return total
+
+
+def film_rgb(cos1, d_nm, n_film, n_sub, wavelengths=0):
+    if wavelengths > 0:
+        return film_rgb_spectral(cos1, d_nm, n_film, n_sub, wavelengths)
+    return film_rgb_fast(cos1, d_nm, n_film, n_sub)

@@ -1,0 +1,103 @@
+"""The visible spectrum as continuous colour weights, for the fast RGB paths.
+
+The spectral paths sum per-wavelength values with ``spectrum.rgb_weights``: CIE
+1931 2° colour matching functions taken to linear sRGB and white balanced so a
+flat spectrum gives R = G = B. The fast paths need the same weights as
+*densities* (per nm, or per µm⁻¹ of wavenumber) so that an integral can be done
+in closed form:
+
+- ``density_table``: ŵ_c(λ) per nm on a 5 nm grid, each channel integrating to
+  1 over 380-780 nm; the grating's fast path reads it at the wavelength an
+  order diffracts toward the viewer (Stam 1999's idea).
+- ``SENSITIVITY``: ŵ_c(ν) over wavenumber ν = 1/λ (µm⁻¹) as three Gaussians per
+  channel, fitted once (least squares, worst error 2-3 % of each peak) by the
+  method of Belcour & Barla 2017: the Fourier transform of a Gaussian is a
+  Gaussian, so ∫ ŵ_c(ν) cos(2π·OPD·ν + s) dν has a closed form, which is what
+  lets a thin film's spectral integral be evaluated without wavelengths. Fitted
+  to our own white-balanced sRGB weights (not XYZ), so the fast path converges
+  to the spectral one where the film's colour is flat.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from opaline.model.spectrum import RANGE_NM
+
+TABLE_STEP_NM = 5.0
+TABLE_SIZE = int((RANGE_NM[1] - RANGE_NM[0]) / TABLE_STEP_NM) + 1  # 81 entries, both ends
+
+# (amplitude, centre µm⁻¹, sigma µm⁻¹) per Gaussian, three per channel R, G, B.
+_FIT = np.array(
+    [
+        [[-1.88797, 1.92344, 0.09143], [0.36209, 2.29094, 0.06470], [7.19224, 1.64947, 0.07647]],
+        [[-1.18006, 1.62690, 0.06536], [4.43477, 1.83431, 0.11592], [-0.44305, 2.26653, 0.08333]],
+        [[3.99580, 2.20599, 0.10622], [-0.55083, 1.79592, 0.10334], [0.72614, 2.31818, 0.04133]],
+    ]
+)
+
+
+def _fine_density() -> tuple[np.ndarray, np.ndarray]:
+    import colour  # late: slow to import, only the physical sources need it here
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    lam = np.arange(RANGE_NM[0], RANGE_NM[1] + 0.5, 1.0)
+    rgb = np.array([cmfs[w] for w in lam]) @ colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB.T
+    return lam, rgb / np.trapezoid(rgb, lam, axis=0)
+
+
+@lru_cache(maxsize=1)
+def density_table() -> tuple[np.ndarray, np.ndarray]:
+    """(λ in nm, ŵ per nm as (TABLE_SIZE, 3)): each channel integrates to 1."""
+    lam, dens = _fine_density()
+    grid = RANGE_NM[0] + TABLE_STEP_NM * np.arange(TABLE_SIZE)
+    table = np.stack([np.interp(grid, lam, dens[:, c]) for c in range(3)], axis=1)
+    table /= np.trapezoid(table, grid, axis=0)
+    table.setflags(write=False)
+    return grid, table
+
+
+def density_at(lam_nm) -> np.ndarray:
+    """ŵ(λ) per nm by linear interpolation in the table; 0 outside the visible range.
+
+    Mirrors ``visible_density`` in glsl/lib/grating.glsl."""
+    grid, table = density_table()
+    lam = np.asarray(lam_nm, dtype=np.float64)
+    x = (lam - RANGE_NM[0]) / TABLE_STEP_NM
+    inside = (x >= 0.0) & (x <= TABLE_SIZE - 1)
+    x = np.clip(x, 0.0, TABLE_SIZE - 1.0)
+    i = np.minimum(np.floor(x).astype(int), TABLE_SIZE - 2)
+    f = (x - i)[..., None]
+    value = table[i] * (1.0 - f) + table[i + 1] * f
+    return np.where(inside[..., None], value, 0.0)
+
+
+@lru_cache(maxsize=1)
+def sensitivity_gaussians() -> np.ndarray:
+    """(3 Gaussians, 3 channels, 3 values): amplitude·σ·√(2π) (the Gaussian's integral),
+    centre and σ, amplitudes scaled so each channel integrates to exactly 1 (white)."""
+    fit = _FIT.copy()
+    integral = fit[..., 0] * fit[..., 2] * np.sqrt(2.0 * np.pi)  # (channel, k)
+    integral /= integral.sum(axis=1, keepdims=True)
+    out = np.stack([integral, fit[..., 1], fit[..., 2]], axis=-1)  # (channel, k, 3)
+    out = np.ascontiguousarray(out.transpose(1, 0, 2))  # (k, channel, 3)
+    out.setflags(write=False)
+    return out
+
+
+def sensitivity(opd_um, shift) -> np.ndarray:
+    """∫ ŵ_c(ν) cos(2π·opd·ν + shift) dν per channel, in closed form from the Gaussians.
+
+    Mirrors ``film_sensitivity`` in glsl/lib/thin_film.glsl. ``opd_um``: optical path
+    difference in µm; the result has a trailing axis of 3 (R, G, B)."""
+    g = sensitivity_gaussians()
+    opd = np.asarray(opd_um, dtype=np.float64)[..., None]
+    shift = np.asarray(shift, dtype=np.float64)[..., None]
+    total = 0.0
+    for k in range(g.shape[0]):
+        weight, centre, sigma = g[k, :, 0], g[k, :, 1], g[k, :, 2]
+        damp = np.exp(-2.0 * (np.pi * sigma * opd) ** 2)
+        total = total + weight * np.cos(2.0 * np.pi * centre * opd + shift) * damp
+    return total
