@@ -17,6 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 import httpx
 import pytest
 
+from opaline.batch.run import Options, run_batch
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
@@ -111,6 +112,23 @@ def test_a_burst_of_equal_requests_renders_once(deployment):
     statuses = sorted({a.headers["x-cache-status"] for a in answers})
     print(f"\nburst: 50 equal requests in {wall:.2f} s, renders per replica {made}, "
           f"cache statuses {statuses}")
+
+
+def test_a_batch_fans_out_over_the_replicas(deployment, tmp_path):
+    """`opaline batch --server` with the proxy's URL: the renders spread over both replicas."""
+    replicas, proxy, _ = deployment
+    folder = tmp_path / "materials"
+    folder.mkdir()
+    for i in range(12):
+        (folder / f"m{i:02d}.toml").write_text(
+            f'preset = "{PRESET}"\nmu_f = {7 + i / 9}\nwidth = 64\nheight = 64\n')
+    before = [renders(r) for r in replicas]
+    summary = run_batch([folder], Options(out=tmp_path / "out", jobs=4, server=proxy.base,
+                                          quiet=True))
+    made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    assert summary["counts"]["rendered"] == 12 and sum(made) == 12
+    assert min(made) >= 3, made  # round robin: neither replica idle
+    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}")
 
 
 def test_killing_a_replica_loses_no_request(deployment):
