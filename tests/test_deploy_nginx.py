@@ -11,8 +11,10 @@ from __future__ import annotations
 import os
 import re
 import signal
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
 import httpx
 import pytest
@@ -61,12 +63,16 @@ def upstream(line: str) -> str:
     return re.search(r" up=(.*?) cache=", line).group(1)
 
 
-@pytest.fixture(scope="module")
-def deployment():
+def need_nginx() -> None:
     if nginx_binary() is None:
         if os.environ.get("CI"):
             pytest.fail("nginx is missing: scripts/test installs it (OPALINE_EXTRA_DEBS)")
         pytest.skip("nginx is not installed (apt-get install nginx-light)")
+
+
+@pytest.fixture(scope="module")
+def deployment():
+    need_nginx()
     with (LocalServer(env=REPLICA_ENV) as a, LocalServer(env=REPLICA_ENV) as b,
           LocalProxy([a.base, b.base]) as proxy,
           httpx.Client(base_url=proxy.base, trust_env=False, timeout=60,
@@ -170,3 +176,39 @@ def test_killing_a_replica_loses_no_request(deployment):
     print(f"\nfail-over: replica killed after {killed_after} of {len(targets)} answers; "
           f"all {len(targets)} answered 200: {retried} retried on the survivor by nginx, "
           f"{len(cut)} cut off mid-answer and asked again by the client")
+
+
+class VaryingUpstream(BaseHTTPRequestHandler):
+    """An upstream whose answer depends on Accept and says so (Vary), as format=auto does."""
+
+    def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        body = f"made for {self.headers.get('Accept')}".encode()
+        self.send_response(200)
+        for name, value in (("Content-Type", "text/plain"), ("Vary", "Accept"),
+                            ("Cache-Control", "public, max-age=60"),
+                            ("Content-Length", str(len(body)))):
+            self.send_header(name, value)
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args: object) -> None:
+        pass
+
+
+def test_the_cache_keeps_one_variant_per_accept():
+    """Vary: Accept is honoured: each Accept gets its own answer, each cached apart."""
+    need_nginx()
+    server = ThreadingHTTPServer(("127.0.0.1", 0), VaryingUpstream)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        with (LocalProxy([f"http://127.0.0.1:{server.server_port}"]) as proxy,
+              httpx.Client(base_url=proxy.base, trust_env=False) as client):
+            seen = []
+            for accept in ("image/avif", "image/png", "image/avif", "image/png"):
+                answer = client.get("/v1/render?x=1", headers={"Accept": accept})
+                assert answer.text == f"made for {accept}"
+                seen.append(answer.headers["x-cache-status"])
+        assert seen == ["MISS", "MISS", "HIT", "HIT"]
+    finally:
+        server.shutdown()
+        server.server_close()
