@@ -105,3 +105,17 @@ def test_every_answer_names_the_canonical_url(backend):
         stale = client.get(location[:-32] + "0" * 32)  # rev is last: another content key
         assert stale.status_code == 200 and "immutable" not in stale.headers["cache-control"]
         assert stale.headers["content-location"] == location
+
+
+@pytest.mark.gl
+def test_mdf_plots_have_canonical_urls_too(backend):
+    """GET /v1/mdf names its canonical URL; there it is immutable, with the same bytes."""
+    settings = Settings(gl_backend=backend, warmup=False, calibrate=False)
+    with TestClient(create_app(settings)) as client:
+        spelled = client.get("/v1/mdf?size=32&alpha=1.50&mu_f=5&format=png&mdf=multipeak")
+        location = spelled.headers["content-location"]
+        assert location.startswith("/v1/mdf?mu_f=5&alpha=1.5&size=32&rev=")
+        assert "immutable" not in spelled.headers["cache-control"]
+        got = client.get(location)
+        assert got.headers["cache-control"] == IMMUTABLE and got.content == spelled.content
+        assert got.headers["content-location"] == location

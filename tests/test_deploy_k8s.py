@@ -21,7 +21,11 @@ from opaline.server.localproxy import TEMPLATE, nginx_binary
 from opaline.server.service import Service
 from opaline.settings import Settings, memory_budget_bytes
 
-kubernetes_validate = pytest.importorskip("kubernetes_validate")
+# In CI (the test extra installs it) a missing validator is a failure, not a skip.
+if os.environ.get("CI"):
+    import kubernetes_validate
+else:
+    kubernetes_validate = pytest.importorskip("kubernetes_validate")
 ROOT = Path(__file__).resolve().parent.parent
 K8S = ROOT / "deploy" / "k8s"
 KUBERNETES = "1.37.0"

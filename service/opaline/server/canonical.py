@@ -11,7 +11,8 @@ any other spelling (or a stale ``rev``) is still answered, with the image, but
 cacheable for ``cache_max_age_s`` only, since an upgrade (new shaders, new
 preset defaults) changes what it leads to. Not a redirect: clients that do not
 follow redirects (httpx, curl without -L) keep working, at the price of a
-second render when two replicas see two spellings of one image.
+second render when two replicas see two spellings of one image. MDF plots
+(GET /v1/mdf) get the same treatment, their defaults being ``Material()``'s.
 """
 
 from __future__ import annotations
@@ -21,12 +22,13 @@ from urllib.parse import urlencode
 
 from pydantic import Field
 
-from opaline.model.params import MATERIAL_FIELDS, RenderRequest
+from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import Preset
 from opaline.model.request import Job, resolve
-from opaline.server.queries import RenderQuery
+from opaline.server.queries import MdfQuery, RenderQuery
 
 RENDER_PATH = "/v1/render"
+MDF_PATH = "/v1/mdf"
 # A year: the longest max-age caches honour (RFC 9111 §5.2.2.1 advises at most one).
 IMMUTABLE = "public, max-age=31536000, immutable"
 # Fixed order: the scene, then the tier (it sets the defaults of samples, wavelengths, aa),
@@ -35,14 +37,16 @@ ORDER = ("preset", "quality", *(n for n in RenderRequest.model_fields
                                 if n not in ("preset", "quality")))
 
 
+REV = Field(None, pattern="^[0-9a-f]{32}$",
+            description="Content key of the image, as the service writes it in the canonical "
+                        "URL it names in Content-Location. A URL with the current rev is "
+                        "immutable; with none or a stale one the image is still answered.")
+
+
 class CanonicalQuery(RenderQuery):
     """GET /v1/render's query: the request, and the content key of a canonical URL."""
 
-    rev: str | None = Field(
-        None, pattern="^[0-9a-f]{32}$",
-        description="Content key of the image (set by the service in its canonical URLs: "
-                    "POST's Content-Location, redirects). A URL with the current rev is "
-                    "immutable; a stale one is redirected to the current image.")
+    rev: str | None = REV
 
     def request(self) -> RenderRequest:
         return RenderRequest(**self.model_dump(exclude={"rev"}, exclude_none=True))
@@ -96,5 +100,30 @@ def canonical_url(query: dict[str, str], key: str) -> str:
 
 
 def is_canonical(raw_query: str, canonical: str) -> bool:
-    """Whether a request's raw query string is exactly the canonical one."""
-    return f"{RENDER_PATH}?{raw_query}" == canonical
+    """Whether a request's raw query string is exactly the canonical URL's."""
+    return canonical.partition("?")[2] == raw_query
+
+
+class CanonicalMdfQuery(MdfQuery):
+    """GET /v1/mdf's query with the content key of a canonical URL."""
+
+    rev: str | None = REV
+
+    def plot(self) -> MdfQuery:
+        return MdfQuery(**self.model_dump(exclude={"rev"}, exclude_none=True))
+
+
+def canonical_plot(params: MdfQuery) -> tuple[MdfQuery, dict[str, str]]:
+    """An MDF plot's query without what the defaults give (material fields against
+    ``Material()``), spelled once and read back, as ``canonical_job`` does for renders."""
+    material, default = Material(**params.model_dump(include=set(MATERIAL_FIELDS),
+                                                     exclude_none=True)), Material()
+    query = {name: spell(getattr(material, name)) for name in MATERIAL_FIELDS
+             if getattr(material, name) != getattr(default, name)}
+    query.update({name: spell(getattr(params, name)) for name in ("size", "format", "wavelengths")
+                  if getattr(params, name) != MdfQuery.model_fields[name].default})
+    return CanonicalMdfQuery.model_validate(query).plot(), query
+
+
+def mdf_url(query: dict[str, str], key: str) -> str:
+    return f"{MDF_PATH}?{urlencode({**query, 'rev': key}, safe=',')}"

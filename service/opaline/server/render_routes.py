@@ -21,10 +21,13 @@ from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.canonical import (
     IMMUTABLE,
+    CanonicalMdfQuery,
     CanonicalQuery,
     canonical_job,
+    canonical_plot,
     canonical_url,
     is_canonical,
+    mdf_url,
 )
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
 from opaline.server.queries import MdfQuery
@@ -103,23 +106,25 @@ IMAGE = {"schema": {"type": "string", "format": "binary"}}
 ETAG = {"ETag": {"description": "Strong validator: a hash of the image's bytes, the same from "
                                 "every replica that draws them; a GET that sends it back in "
                                 "If-None-Match gets 304.",
-                 "schema": {"type": "string"}},
-        "Content-Location": {"description": "The image's canonical GET URL: parameters in a "
-                                            "fixed order, defaults dropped, rev = its content "
-                                            "key; immutable, one URL per image for caches.",
-                             "schema": {"type": "string"}}}
+                 "schema": {"type": "string"}}}
+LOCATION = {"Content-Location": {"description": "The image's canonical GET URL: parameters in "
+                                                "a fixed order, defaults dropped, rev = its "
+                                                "content key; immutable, one URL per image.",
+                                 "schema": {"type": "string"}}}
 CONDITIONAL: dict[int | str, dict[str, Any]] = {
     304: {"description": "Not modified: If-None-Match matched the ETag."}}
 RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
+          "headers": {**ETAG, **LOCATION}},
     404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
     413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
 }
 MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
+          "headers": {**ETAG, **LOCATION}},
     **CONDITIONAL, **ERROR_RESPONSES,
 }
 router = APIRouter()
@@ -141,10 +146,15 @@ async def render_get(params: Annotated[CanonicalQuery, Query()], request: Reques
 
 @router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
             summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
-async def mdf_get(params: Annotated[MdfQuery, Query()], request: Request,
+async def mdf_get(query: Annotated[CanonicalMdfQuery, Query()], request: Request,
                   svc: ServiceDep) -> Response:
+    params, canonical = canonical_plot(query.plot())
     check_mdf_limits(params, svc.settings)
     material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
     key = mdf_key(material, params.size, params.format, params.wavelengths)
+    url = mdf_url(canonical, key)
+    headers = {"Content-Location": url}
+    if is_canonical(request.url.query, url):
+        headers["Cache-Control"] = IMMUTABLE
     task = MdfTask(material, params.size, params.format, params.wavelengths)
-    return await answer_image(svc, request, key, task, params.format, "mdf")
+    return await answer_image(svc, request, key, task, params.format, "mdf", headers)
