@@ -27,6 +27,7 @@ from opaline import __version__
 from opaline.batch.plan import Task, plan, prune, remove_temporaries, write_result
 from opaline.batch.pool import start_pool
 from opaline.batch.progress import PlainProgress, make_progress
+from opaline.batch.shard import select
 from opaline.batch.sheet import write_contact_sheet
 from opaline.model.materials import Item, collect
 from opaline.output.files import write_atomic
@@ -50,6 +51,7 @@ class Options:
     retries: int = 5
     prune: bool = False  # remove outputs (with sidecars) whose material is gone
     quiet: bool = False  # no progress lines; failures are still told on stderr
+    shard: tuple[int, int] | None = None  # (K, N): render shard K of N only (batch.shard)
 
     @property
     def summary_path(self) -> Path:
@@ -66,7 +68,9 @@ def run_batch(inputs: list[str | Path], options: Options,
         raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
     # With --server the server checks the cost, against its own budget.
     budget = None if options.server else get_settings().cost_budget
-    tasks = plan(items, options.out, force=options.force, cost_budget=budget)
+    # Every shard prunes against all items: the others' outputs are not "gone".
+    tasks = plan(select(items, options.shard), options.out, force=options.force,
+                 cost_budget=budget)
     progress = progress or make_progress(options.quiet)
     progress.start(tasks)
     try:
@@ -152,6 +156,7 @@ def write_summary(tasks: list[Task], options: Options, started: float,
         "out": str(options.out),
         "server": options.server,
         "jobs": options.jobs,
+        **({"shard": "{}/{}".format(*options.shard)} if options.shard else {}),
         "seconds": round(time.monotonic() - started, 3),
         "interrupted": interrupted,
         "counts": counts,

@@ -12,6 +12,7 @@ from pydantic import ValidationError
 
 from opaline.batch.report import github_annotations, junit_xml
 from opaline.batch.run import NothingToRender, Options, _raise_interrupt, _signals, run_batch
+from opaline.batch.shard import ShardError, parse_shard
 from opaline.cli.args import CliError, add_common, parse_size, write_output
 from opaline.model.params import ImageFormat, Quality, RenderRequest, describe_errors
 
@@ -59,10 +60,14 @@ def options_from_args(args: argparse.Namespace) -> Options:
     # Per item, 100 retries wait at most about 17 minutes (the client caps a delay at 10 s).
     if not 0 <= args.retries <= 100:
         raise CliError(f"--retries={args.retries} is out of range: allowed [0 … 100]")
+    try:
+        shard = parse_shard(args.shard) if args.shard else None
+    except ShardError as exc:
+        raise CliError(str(exc)) from None
     return Options(out=Path(args.out), jobs=jobs, overrides=overrides, server=args.server,
                    backend=args.backend, sheet=args.sheet,
                    summary=Path(args.summary) if args.summary else None, force=args.force,
-                   retries=args.retries, prune=args.prune, quiet=args.quiet)
+                   retries=args.retries, prune=args.prune, quiet=args.quiet, shard=shard)
 
 
 def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -110,6 +115,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--summary", metavar="FILE",
                         help="machine-readable summary (default DIR/summary.json)")
     parser.add_argument("--force", action="store_true", help="render even if up to date")
+    parser.add_argument("--shard", metavar="K/N",
+                        help="render only shard K of N (1 ≤ K ≤ N), chosen by a hash of each "
+                             "output name, so shards stay put as inputs come and go; "
+                             "`opaline batch-merge` joins the shards' summaries")
     parser.add_argument("--prune", action="store_true",
                         help="remove images (and their .json sidecars) in DIR whose material "
                              "is gone; only files a batch wrote are touched")

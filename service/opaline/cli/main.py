@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from opaline import __version__
-from opaline.cli import batch, gallery, render, schema, serve
+from opaline.cli import batch, gallery, merge, render, schema, serve
 from opaline.cli.args import CliError
 from opaline.model.material_file import MaterialError
 from opaline.model.params import RenderRequest
@@ -98,7 +98,7 @@ def make_parser() -> argparse.ArgumentParser:
     render.add_common(info)
     info.set_defaults(func=cmd_info)
 
-    for module in (gallery, serve, batch, schema):
+    for module in (gallery, serve, batch, merge, schema):
         module.register(sub)
     for name, command in sub.choices.items():
         add_global(command, presets=name in USES_PRESETS)

@@ -16,13 +16,19 @@ from opaline.lru import BudgetLRU
 from opaline.model.params import Material
 from opaline.model.request import content_key
 
+# Validators of images rendered here, kept apart from the images (and longer: ~150 bytes
+# each), so a GET with If-None-Match is answered 304 after its image left the cache.
+MAX_TAGS = 1 << 16
+
 
 class ImageCache:
-    """An LRU mapping of key → encoded image bytes, bounded by their total size."""
+    """An LRU mapping of key → encoded image bytes, bounded by their total size, and of
+    key → the image's ETag, bounded by count."""
 
     def __init__(self, budget_bytes: int) -> None:
         self.budget = budget_bytes
         self._items: BudgetLRU[str, bytes] = BudgetLRU(max_items=1 << 30, max_bytes=budget_bytes)
+        self._tags: BudgetLRU[str, str] = BudgetLRU(max_items=MAX_TAGS, max_bytes=1 << 62)
         self._lock = threading.Lock()
 
     def __len__(self) -> int:
@@ -41,8 +47,15 @@ class ImageCache:
             return self._items.get(key)
 
     def put(self, key: str, data: bytes) -> None:
+        tag = etag(data)
         with self._lock:
             self._items.put(key, data, len(data))
+            self._tags.put(key, tag, 1)
+
+    def tag(self, key: str) -> str | None:
+        """The ETag of the image last rendered here under ``key``, if still known."""
+        with self._lock:
+            return self._tags.get(key)
 
 
 def mdf_key(material: Material, size: int, fmt: str, wavelengths: int) -> str:
@@ -51,17 +64,14 @@ def mdf_key(material: Material, size: int, fmt: str, wavelengths: int) -> str:
                         "format": fmt, "wavelengths": wavelengths})
 
 
-def etag(key: str, renderer: str = "") -> str:
-    """A strong ETag for the image under ``key`` as drawn by ``renderer``.
+def etag(data: bytes) -> str:
+    """The strong ETag of an encoded image: a hash of its bytes (docs/design.md, deployment).
 
-    The same request gives the same bytes on the same GL implementation
-    (docs/design.md §9), not across implementations, so the renderer's identity is
-    part of the tag: replicas on different hardware do not share validators.
+    Not of the request: replicas on the same GL implementation draw the same bytes and so
+    answer the same tag, whichever of them rendered; a replica on another GPU or driver,
+    whose bytes may differ, answers another tag, as a strong validator must.
     """
-    if not renderer:
-        return f'"{key}"'
-    digest = hashlib.sha256(f"{key}\0{renderer}".encode()).hexdigest()[:32]
-    return f'"{digest}"'
+    return f'"{hashlib.sha256(data).hexdigest()[:32]}"'
 
 
 def matches(if_none_match: str | None, tag: str) -> bool:

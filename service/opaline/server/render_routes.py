@@ -19,8 +19,18 @@ from opaline.model.presets import get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.server.cache import etag, matches, mdf_key
+from opaline.server.canonical import (
+    IMMUTABLE,
+    CanonicalMdfQuery,
+    CanonicalQuery,
+    canonical_job,
+    canonical_plot,
+    canonical_url,
+    is_canonical,
+    mdf_url,
+)
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
-from opaline.server.queries import MdfQuery, RenderQuery
+from opaline.server.queries import MdfQuery
 from opaline.server.service import Service, get_service
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
@@ -58,48 +68,63 @@ def client_gone(request: Request):
 
 
 async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt: str,
-                       filename: str) -> Response:
+                       filename: str, headers: dict[str, str] | None = None) -> Response:
     """The image under ``key``: 304, from the cache, or rendered by a worker."""
-    tag = etag(key, svc.pool.identity)
-    headers = {"ETag": tag}
+    headers = dict(headers or {})
     if request.method == "GET":
-        headers["Cache-Control"] = f"public, max-age={svc.settings.cache_max_age_s}"
-        if matches(request.headers.get("if-none-match"), tag):
-            return Response(status_code=304, headers=headers)
+        headers.setdefault("Cache-Control", f"public, max-age={svc.settings.cache_max_age_s}")
+        tag = svc.cache.tag(key)
+        if tag is not None and matches(request.headers.get("if-none-match"), tag):
+            return Response(status_code=304, headers={**headers, "ETag": tag})
     data = svc.cache.get(key)
     if data is not None:
         svc.metrics.cache_hits.inc()
     else:
         svc.metrics.cache_misses.inc()
         data = await svc.pool.render(key, task, timeout=svc.wait_s, gone=client_gone(request))
+    headers["ETag"] = svc.cache.tag(key) or etag(data)
     headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
     return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
 
 
 async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
+    """Every answer names the image's canonical GET URL in Content-Location; only that URL
+    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade)."""
     preset = get_preset(params.preset)
-    job = resolve(params, preset)
+    job, query = canonical_job(resolve(params, preset), preset)
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
-    return await answer_image(svc, request, key, ImageTask(job, preset), job.format, preset.name)
+    url = canonical_url(query, key)
+    headers = {"Content-Location": url}
+    if request.method == "GET" and is_canonical(request.url.query, url):
+        headers["Cache-Control"] = IMMUTABLE
+    return await answer_image(svc, request, key, ImageTask(job, preset), job.format, preset.name,
+                              headers)
 
 
 IMAGE = {"schema": {"type": "string", "format": "binary"}}
-ETAG = {"ETag": {"description": "Strong validator of this image as this service draws it; "
-                                "a GET that sends it back in If-None-Match gets 304.",
+ETAG = {"ETag": {"description": "Strong validator: a hash of the image's bytes, the same from "
+                                "every replica that draws them; a GET that sends it back in "
+                                "If-None-Match gets 304.",
                  "schema": {"type": "string"}}}
+LOCATION = {"Content-Location": {"description": "The image's canonical GET URL: parameters in "
+                                                "a fixed order, defaults dropped, rev = its "
+                                                "content key; immutable, one URL per image.",
+                                 "schema": {"type": "string"}}}
 CONDITIONAL: dict[int | str, dict[str, Any]] = {
     304: {"description": "Not modified: If-None-Match matched the ETag."}}
 RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
+          "headers": {**ETAG, **LOCATION}},
     404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
     413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
 }
 MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE}, "headers": ETAG},
+          "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
+          "headers": {**ETAG, **LOCATION}},
     **CONDITIONAL, **ERROR_RESPONSES,
 }
 router = APIRouter()
@@ -114,17 +139,22 @@ async def render_post(body: RenderRequest, request: Request, svc: ServiceDep) ->
 @router.get("/v1/render", tags=["render"], response_class=Response,
             responses={**RENDER_RESPONSES, **CONDITIONAL},
             summary="Render a preset with material overrides (query string, for <img src>)")
-async def render_get(params: Annotated[RenderQuery, Query()], request: Request,
+async def render_get(params: Annotated[CanonicalQuery, Query()], request: Request,
                      svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, params)
+    return await answer_render(svc, request, params.request())
 
 
 @router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
             summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
-async def mdf_get(params: Annotated[MdfQuery, Query()], request: Request,
+async def mdf_get(query: Annotated[CanonicalMdfQuery, Query()], request: Request,
                   svc: ServiceDep) -> Response:
+    params, canonical = canonical_plot(query.plot())
     check_mdf_limits(params, svc.settings)
     material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
     key = mdf_key(material, params.size, params.format, params.wavelengths)
+    url = mdf_url(canonical, key)
+    headers = {"Content-Location": url}
+    if is_canonical(request.url.query, url):
+        headers["Cache-Control"] = IMMUTABLE
     task = MdfTask(material, params.size, params.format, params.wavelengths)
-    return await answer_image(svc, request, key, task, params.format, "mdf")
+    return await answer_image(svc, request, key, task, params.format, "mdf", headers)

@@ -1,0 +1,214 @@
+"""Debian's nginx in front of two replicas, all on loopback: the deployment of deploy/nginx.
+
+Shows, with the figures printed (pytest -s): a miss on one replica is a hit for
+requests that the balancer routes to the other; 50 concurrent equal requests
+render once across both replicas; killing a replica mid-run loses no request
+the other can serve. Bounded: small images, about 30 s in all on 2 cores.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+import httpx
+import pytest
+
+from opaline.batch.run import Options, run_batch
+from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
+from opaline.model.request import resolve
+from opaline.server.canonical import canonical_job, canonical_url
+from opaline.server.localproxy import LocalProxy, nginx_binary
+from opaline.server.localserver import LocalServer
+
+pytestmark = pytest.mark.gl
+REPLICA_ENV = {"OPALINE_CALIBRATE": "0", "OPALINE_QUEUE_SIZE": "64", "OPALINE_DEADLINE_S": "30"}
+PRESET = "cd-rom"  # the warm-up renders "sphere": counting cd-rom renders counts ours only
+
+
+def url(**fields) -> str:
+    """The canonical URL, as a client learns it from Content-Location."""
+    request = RenderRequest(**{"preset": PRESET, "quality": "draft", **fields})
+    preset = get_preset(PRESET)
+    job, query = canonical_job(resolve(request, preset), preset)
+    return canonical_url(query, job.cache_key(preset.scene_key()))
+
+
+def renders(replica: LocalServer) -> float:
+    """Renders of PRESET this replica has made (its /metrics)."""
+    text = httpx.get(replica.base + "/metrics", trust_env=False).text
+    found = re.search(rf'^opaline_render_seconds_count\{{preset="{PRESET}"\}} (\S+)$', text, re.M)
+    return float(found.group(1)) if found else 0.0
+
+
+def log_lines(proxy: LocalProxy, path: str, count: int = 1) -> list[str]:
+    """nginx's log lines for ``path``; it writes one just after answering, so wait for
+    ``count`` of them (a second at most)."""
+    deadline = time.monotonic() + 1.0
+    while True:
+        lines = [line for line in proxy.log().splitlines() if f'"GET {path} ' in line]
+        if len(lines) >= count or time.monotonic() > deadline:
+            return lines
+        time.sleep(0.01)
+
+
+def upstream(line: str) -> str:
+    """Which replica answered: '-' for the cache, 'A, B' when A failed and B answered."""
+    return re.search(r" up=(.*?) cache=", line).group(1)
+
+
+def need_nginx() -> None:
+    if nginx_binary() is None:
+        if os.environ.get("CI"):
+            pytest.fail("nginx is missing: scripts/test installs it (OPALINE_EXTRA_DEBS)")
+        pytest.skip("nginx is not installed (apt-get install nginx-light)")
+
+
+@pytest.fixture(scope="module")
+def deployment():
+    need_nginx()
+    with (LocalServer(env=REPLICA_ENV) as a, LocalServer(env=REPLICA_ENV) as b,
+          LocalProxy([a.base, b.base]) as proxy,
+          httpx.Client(base_url=proxy.base, trust_env=False, timeout=60,
+                       limits=httpx.Limits(max_connections=64)) as client):
+        yield [a, b], proxy, client
+
+
+def test_a_miss_on_one_replica_is_a_hit_routed_to_the_other(deployment):
+    replicas, proxy, client = deployment
+    before = [renders(r) for r in replicas]
+    first = client.get(url(mu_f=4.25, width=64, height=64))
+    assert first.status_code == 200 and first.headers["x-cache-status"] == "MISS"
+    routed = set()
+    for i in range(6):  # other images between the repeats: round robin visits both replicas
+        other = client.get(url(mu_f=1 + i / 8, width=64, height=64))
+        assert other.status_code == 200
+        routed.add(upstream(log_lines(proxy, url(mu_f=1 + i / 8, width=64, height=64))[0]))
+        again = client.get(url(mu_f=4.25, width=64, height=64))
+        assert again.headers["x-cache-status"] == "HIT" and again.content == first.content
+        assert again.headers["etag"] == first.headers["etag"]
+    lines = log_lines(proxy, url(mu_f=4.25, width=64, height=64), 7)
+    assert [upstream(line) for line in lines[1:]] == ["-"] * 6  # no replica saw a repeat
+    assert routed == {r.base.removeprefix("http://") for r in replicas}
+    made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    assert sum(made) == 7  # the first image once, six others once each
+    print(f"\nshared cache: 1 miss via {upstream(lines[0])}, 6 repeats answered by nginx "
+          f"(HIT) while other images went to {sorted(routed)}; renders per replica {made}")
+
+
+def test_a_burst_of_equal_requests_renders_once(deployment):
+    replicas, proxy, client = deployment
+    target = url(mu_f=6.5, width=192, height=192, quality="standard")
+    before = [renders(r) for r in replicas]
+    started = time.monotonic()
+    with ThreadPoolExecutor(50) as pool:
+        answers = list(pool.map(lambda _: client.get(target), range(50), timeout=60))
+    wall = time.monotonic() - started
+    assert [a.status_code for a in answers] == [200] * 50
+    assert len({a.content for a in answers}) == 1
+    made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    upstreams = [upstream(line) for line in log_lines(proxy, target, 50)]
+    assert sum(made) == 1 and sum(u != "-" for u in upstreams) == 1, (made, upstreams)
+    statuses = sorted({a.headers["x-cache-status"] for a in answers})
+    print(f"\nburst: 50 equal requests in {wall:.2f} s, renders per replica {made}, "
+          f"cache statuses {statuses}")
+
+
+def test_a_batch_fans_out_over_the_replicas(deployment, tmp_path):
+    """`opaline batch --server` with the proxy's URL: the renders spread over both replicas."""
+    replicas, proxy, _ = deployment
+    folder = tmp_path / "materials"
+    folder.mkdir()
+    for i in range(12):
+        (folder / f"m{i:02d}.toml").write_text(
+            f'preset = "{PRESET}"\nmu_f = {7 + i / 9}\nwidth = 64\nheight = 64\n')
+    before = [renders(r) for r in replicas]
+    summary = run_batch([folder], Options(out=tmp_path / "out", jobs=4, server=proxy.base,
+                                          quiet=True))
+    made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    assert summary["counts"]["rendered"] == 12 and sum(made) == 12
+    assert min(made) >= 3, made  # round robin: neither replica idle
+    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}")
+
+
+def test_killing_a_replica_loses_no_request(deployment):
+    """A replica crashes (SIGKILL) mid-run. nginx sends every request that it has not begun
+    to answer to the survivor. The one thing no streaming proxy can redo is an answer the
+    dead replica had begun to send: its client sees the connection cut and asks again
+    (a GET is safe to repeat), so only requests in flight at the kill may need that."""
+    replicas, proxy, client = deployment
+    targets = [url(mu_f=2 + i / 7, width=64, height=64) for i in range(30)]
+    done: list[int] = []
+    cut: list[float] = []  # when each request that was cut off had started
+    killed = [float("inf")]
+
+    def ask(path: str) -> int:
+        started = time.monotonic()
+        try:
+            status = client.get(path).status_code
+        except httpx.TransportError:
+            cut.append(started)
+            status = client.get(path).status_code
+        done.append(status)
+        return status
+
+    with ThreadPoolExecutor(4) as pool:
+        futures = [pool.submit(ask, t) for t in targets]
+        while len(done) < 5:
+            time.sleep(0.01)
+        killed[0] = time.monotonic()
+        replicas[0].proc.send_signal(signal.SIGKILL)  # a crash: no graceful shutdown
+        killed_after = len(done)
+        statuses = [f.result(timeout=60) for f in futures]
+    assert statuses == [200] * len(targets), statuses
+    assert len(cut) <= 4 and all(started < killed[0] for started in cut)
+    ups = [upstream(log_lines(proxy, t)[0]) for t in targets]
+    survivor = replicas[1].base.removeprefix("http://")
+    # Requests begun after the kill (the pool's 4 threads were busy with earlier ones):
+    assert all(u.split(", ")[-1] == survivor for u in ups[killed_after + 4:])
+    retried = sum(", " in u for u in ups)
+    print(f"\nfail-over: replica killed after {killed_after} of {len(targets)} answers; "
+          f"all {len(targets)} answered 200: {retried} retried on the survivor by nginx, "
+          f"{len(cut)} cut off mid-answer and asked again by the client")
+
+
+class VaryingUpstream(BaseHTTPRequestHandler):
+    """An upstream whose answer depends on Accept and says so (Vary), as format=auto does."""
+
+    def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        body = f"made for {self.headers.get('Accept')}".encode()
+        self.send_response(200)
+        for name, value in (("Content-Type", "text/plain"), ("Vary", "Accept"),
+                            ("Cache-Control", "public, max-age=60"),
+                            ("Content-Length", str(len(body)))):
+            self.send_header(name, value)
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args: object) -> None:
+        pass
+
+
+def test_the_cache_keeps_one_variant_per_accept():
+    """Vary: Accept is honoured: each Accept gets its own answer, each cached apart."""
+    need_nginx()
+    server = ThreadingHTTPServer(("127.0.0.1", 0), VaryingUpstream)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        with (LocalProxy([f"http://127.0.0.1:{server.server_port}"]) as proxy,
+              httpx.Client(base_url=proxy.base, trust_env=False) as client):
+            seen = []
+            for accept in ("image/avif", "image/png", "image/avif", "image/png"):
+                answer = client.get("/v1/render?x=1", headers={"Accept": accept})
+                assert answer.text == f"made for {accept}"
+                seen.append(answer.headers["x-cache-status"])
+        assert seen == ["MISS", "MISS", "HIT", "HIT"]
+    finally:
+        server.shutdown()
+        server.server_close()
