@@ -26,7 +26,8 @@ from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
 from opaline.server.cache import ImageCache
-from opaline.server.errors import Problem, install
+from opaline.server.errors import ERROR_RESPONSES, Problem, install
+from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
@@ -160,12 +161,14 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     metrics.watch(pool.depth, lambda: cache.size_bytes)
     metrics.watch_pool(pool.counters, lambda: cache.evictions)
     app = FastAPI(title="Opaline", version=__version__, lifespan=lifespan,
+                  responses={k: ERROR_RESPONSES[k] for k in (403, 404, 422, 429, 500)},
                   description="Headless previews of iridescent materials "
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
     install(app, settings.max_body_bytes, metrics)
+    app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)
     app.include_router(render_router)
     app.include_router(router)
     mount_web(app)

@@ -20,7 +20,8 @@ from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
-from opaline.server.queries import MdfQuery, RenderQuery
+from opaline.server.queries import MdfQuery, RenderQuery, parse_body
+from opaline.server.streaming import image_response
 from opaline.server.service import Service, get_service
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
@@ -73,7 +74,7 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
         svc.metrics.cache_misses.inc()
         data = await svc.pool.render(key, task, timeout=svc.wait_s, gone=client_gone(request))
     headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
-    return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
+    return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
 async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
@@ -105,10 +106,16 @@ MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
 router = APIRouter()
 
 
+# The body is parsed strictly by parse_body (numbers are JSON numbers), so the route
+# documents it itself instead of letting FastAPI parse it laxly.
+BODY = {"requestBody": {"required": True, "content": {
+    "application/json": {"schema": RenderRequest.model_json_schema()}}}}
+
+
 @router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
-             summary="Render a preset with material overrides (JSON body)")
-async def render_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, body)
+             summary="Render a preset with material overrides (JSON body)", openapi_extra=BODY)
+async def render_post(request: Request, svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, parse_body(await request.body(), RenderRequest))
 
 
 @router.get("/v1/render", tags=["render"], response_class=Response,
