@@ -16,9 +16,10 @@ from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import JSONResponse
+from fastapi.responses import JSONResponse, Response
 from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException
+from starlette.requests import ClientDisconnect
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from opaline.model.params import RenderRequest, describe_errors
@@ -146,6 +147,12 @@ async def on_http_error(request: Request, exc: HTTPException) -> JSONResponse:
     return problem(exc.status_code, reason, str(exc.detail), headers=exc.headers)
 
 
+async def on_gone(request: Request, exc: ClientDisconnect) -> Response:
+    """The client left (or was dropped for a slow body) while its body was read: no one to
+    answer, nothing to log."""
+    return Response(status_code=400)
+
+
 async def on_crash(request: Request, exc: Exception) -> JSONResponse:
     """A bug: 500 in the public shape; the traceback goes to the log (Starlette logs it)."""
     request.app.state.metrics.reject("error")
@@ -192,6 +199,7 @@ def install(app: FastAPI, max_body_bytes: int, metrics: Metrics) -> None:
                        on_reject=partial(metrics.reject, "too_large"))
     app.add_exception_handler(RequestValidationError, on_invalid)
     app.add_exception_handler(HTTPException, on_http_error)
+    app.add_exception_handler(ClientDisconnect, on_gone)
     app.add_exception_handler(Exception, on_crash)
     for exc_type in PUBLIC_ERRORS:
         app.add_exception_handler(exc_type, on_public_error)

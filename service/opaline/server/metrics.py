@@ -89,6 +89,10 @@ class Metrics:
         evictions at scrape time."""
         self.registry.register(_PoolCollector(counters, image_evictions))
 
+    def watch_connections(self, stats: Mapping[str, int]) -> None:
+        """Export the connection layer's refusals and timeouts (opaline.server.connections)."""
+        self.registry.register(_ConnectionCollector(stats))
+
     def reject(self, reason: str) -> None:
         self.rejected.labels(reason).inc()
 
@@ -112,3 +116,20 @@ class _PoolCollector(Collector):
                                      "Images evicted from the HTTP process's cache.")
         images.add_metric([], self.image_evictions())
         yield images
+
+
+class _ConnectionCollector(Collector):
+    def __init__(self, stats: Mapping[str, int]) -> None:
+        self.stats = stats
+
+    def collect(self) -> Iterator[CounterMetricFamily]:
+        refused = CounterMetricFamily("opaline_connections_refused",
+                                      "Connections refused at once, by cap.", labels=["cap"])
+        for cap in ("connections", "per_client"):
+            refused.add_metric([cap], self.stats.get("refused_" + cap, 0))
+        timeouts = CounterMetricFamily("opaline_connection_timeouts",
+                                       "Connections closed for a slow client.", labels=["kind"])
+        for kind in ("header", "body", "write"):
+            timeouts.add_metric([kind], self.stats.get(kind + "_timeouts", 0))
+        yield refused
+        yield timeouts

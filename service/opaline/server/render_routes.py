@@ -21,8 +21,8 @@ from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
 from opaline.server.queries import MdfQuery, RenderQuery, parse_body
-from opaline.server.streaming import image_response
 from opaline.server.service import Service, get_service
+from opaline.server.streaming import image_response
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
@@ -109,7 +109,7 @@ router = APIRouter()
 # The body is parsed strictly by parse_body (numbers are JSON numbers), so the route
 # documents it itself instead of letting FastAPI parse it laxly.
 BODY = {"requestBody": {"required": True, "content": {
-    "application/json": {"schema": RenderRequest.model_json_schema()}}}}
+    "application/json": {"schema": {"$ref": "#/components/schemas/RenderRequest"}}}}}
 
 
 @router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
