@@ -81,6 +81,13 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
                 STATS["header_timeouts"] += 1
                 self.transport.close()
 
+        def send_400_response(self, msg: str) -> None:
+            """An unparsable request line or header: uvicorn's text/plain 400, in our shape."""
+            STATS["malformed"] += 1
+            self.transport.write(raw_problem(400, "Bad Request", "malformed",
+                                             "the request is not valid HTTP/1.1"))
+            self.transport.close()
+
         def data_received(self, data: bytes) -> None:
             if self.transport.is_closing():  # refused or timed out: read nothing more
                 return

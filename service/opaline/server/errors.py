@@ -49,7 +49,7 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
     Malformed: (400, "malformed"),
     UnknownPreset: (404, "unknown_preset"),
     CostError: (422, "cost"),
-    LimitError: (422, "invalid"),
+    LimitError: (422, "limit"),
     TooSlow: (422, "too_slow"),
     ValidationError: (422, "invalid"),
     Overloaded: (503, "queue_full"),

@@ -25,7 +25,7 @@ RENDER_BUCKETS = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0,
 
 REJECT_REASONS = ("invalid", "malformed", "unknown_preset", "not_found", "method_not_allowed",
                   "cost", "too_slow", "too_large", "queue_full", "deadline", "unavailable",
-                  "cancelled", "forbidden", "rate_limited", "timeout", "render_failed", "error")
+                  "cancelled", "forbidden", "rate_limited", "timeout", "render_failed", "error", "limit")
 # The worker pool's own counters, exported as they stand at scrape time.
 POOL_COUNTERS = {
     "restarts_crash": ("opaline_worker_restarts", "Worker processes replaced, by reason.",
@@ -127,6 +127,10 @@ class _ConnectionCollector(Collector):
                                       "Connections refused at once, by cap.", labels=["cap"])
         for cap in ("connections", "per_client"):
             refused.add_metric([cap], self.stats.get("refused_" + cap, 0))
+        malformed = CounterMetricFamily("opaline_malformed_http",
+                                        "Requests that were not valid HTTP/1.1 (answered 400).")
+        malformed.add_metric([], self.stats.get("malformed", 0))
+        yield malformed
         timeouts = CounterMetricFamily("opaline_connection_timeouts",
                                        "Connections closed for a slow client.", labels=["kind"])
         for kind in ("header", "body", "write"):

@@ -6,9 +6,11 @@ parameter repeated three times); every other field is the request model's own.
 
 from __future__ import annotations
 
+from functools import cache
 from typing import Any, Literal, TypeVar
 
-from pydantic import BaseModel, Field, ValidationError, field_validator
+from pydantic import BaseModel, Field, field_validator
+from pydantic_core import from_json, to_json
 
 from opaline.model.params import (
     MaterialFields,
@@ -62,8 +64,10 @@ Model = TypeVar("Model", bound=BaseModel)
 
 def parse_body(raw: bytes, model: type[Model]) -> Model:
     """A JSON body as ``model``, strictly: numbers must be JSON numbers and booleans JSON
-    booleans, as the OpenAPI document says ({"mu_f": "6"} and {"mu_f": false} are refused).
-    pydantic's parser bounds the nesting depth; a parse failure is ``Malformed``."""
+    booleans, as the OpenAPI document says ({"mu_f": "6"} and {"mu_f": false} are refused);
+    an integer field takes an integral number written as a float (178.0), as JSON Schema's
+    "integer" does. pydantic's parser bounds the nesting depth; a parse failure is
+    ``Malformed``."""
     if not raw.strip():
         raise Malformed("body: a JSON object is required ({} renders the defaults)")
     try:
@@ -71,11 +75,20 @@ def parse_body(raw: bytes, model: type[Model]) -> Model:
     except UnicodeDecodeError as exc:
         raise Malformed(f"body: not valid UTF-8 (byte {exc.start})") from None
     try:
-        return model.model_validate_json(raw, strict=True)
-    except ValidationError as exc:
-        broken = [e for e in exc.errors() if e["type"] == "json_invalid"]
-        if broken:
-            reason = (broken[0].get("ctx") or {}).get("error", "")
-            raise Malformed(f"body: not valid JSON ({reason})" if reason
-                            else "body: not valid JSON") from None
-        raise
+        data = from_json(raw)
+    except ValueError as exc:
+        raise Malformed(f"body: not valid JSON ({exc})") from None
+    if isinstance(data, dict):
+        for name in integer_fields(model) & data.keys():
+            value = data[name]
+            if isinstance(value, float) and value.is_integer():
+                data[name] = int(value)
+    return model.model_validate_json(to_json(data, inf_nan_mode="constants"), strict=True)
+
+
+@cache
+def integer_fields(model: type[BaseModel]) -> frozenset[str]:
+    """The fields whose JSON type is integer (alone or beside null)."""
+    props = model.model_json_schema()["properties"]
+    return frozenset(name for name, prop in props.items()
+                     if "integer" in {alt.get("type") for alt in prop.get("anyOf", [prop])})
