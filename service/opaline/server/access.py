@@ -26,7 +26,7 @@ from opaline.server import signing
 from opaline.server.errors import problem
 from opaline.settings import Settings, secrets
 
-OPEN = ("/healthz", "/readyz", "/docs", "/redoc", "/openapi.json", "/static/", "/docs-assets/")
+OPEN = ("/healthz", "/readyz", "/docs", "/openapi.json", "/static/", "/docs-assets/")
 SIGNABLE = ("/v1/render", "/v1/mdf")
 MAX_BUCKETS = 65536  # distinct keys and addresses remembered; the least recent go first
 

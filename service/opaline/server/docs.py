@@ -2,8 +2,9 @@
 
 FastAPI's /docs and /redoc load Swagger UI and ReDoc from a CDN, so they were
 blank on an air-gapped machine or in the container. The assets here come from
-the ``fastapi-offline`` package (Swagger UI 5, ReDoc 2) and are served under
-/docs-assets. Every HTML answer gets a Content-Security-Policy that allows only
+the ``fastapi-offline`` package (Swagger UI 5) and are served under
+/docs-assets. (ReDoc is left out: its sidebar loads a logo from cdn.redoc.ly
+whatever its options.) Every HTML answer gets a Content-Security-Policy that allows only
 this origin (the docs' one inline script by its hash), frame-ancestors 'none',
 and every answer ``X-Content-Type-Options: nosniff`` and ``Referrer-Policy:
 no-referrer`` (a signed URL must not leak to other sites through Referer).
@@ -17,16 +18,17 @@ import re
 from pathlib import Path
 
 from fastapi import FastAPI
-from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html
+from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.responses import HTMLResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import MutableHeaders
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 ASSETS = "/docs-assets"
-# The page (app.js) sets no inline script or style; images are blob: URLs of fetched answers.
+# The page (app.js) sets no inline script or style; images are blob: URLs of fetched answers
+# (which a script may read back: connect-src blob:).
 PAGE_CSP = ("default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' blob: data:; "
-            "connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
+            "connect-src 'self' blob:; object-src 'none'; base-uri 'none'; form-action 'self'; "
             "frame-ancestors 'none'")
 INLINE_SCRIPT = re.compile(rb"<script>(.*?)</script>", re.S)
 
@@ -38,12 +40,11 @@ def assets_dir() -> Path:
 
 
 def docs_csp(html: bytes) -> str:
-    """CSP for a docs page: its inline scripts by hash; Swagger UI and ReDoc set inline
-    styles, and ReDoc runs its search in a blob: worker."""
+    """CSP for the docs page: its inline script by hash; Swagger UI sets inline styles."""
     hashes = " ".join("'sha256-" + base64.b64encode(hashlib.sha256(s).digest()).decode() + "'"
                       for s in INLINE_SCRIPT.findall(html))
     return (f"default-src 'self'; script-src 'self' {hashes}; style-src 'self' 'unsafe-inline'; "
-            "img-src 'self' data:; worker-src 'self' blob:; connect-src 'self'; "
+            "img-src 'self' data:; connect-src 'self'; "
             "object-src 'none'; base-uri 'none'; frame-ancestors 'none'")
 
 
@@ -53,8 +54,8 @@ def _with_csp(page: HTMLResponse) -> HTMLResponse:
 
 
 def mount_docs(app: FastAPI) -> None:
-    """/docs (Swagger UI) and /redoc (ReDoc) from local assets; the app is made with
-    ``docs_url=None, redoc_url=None`` so FastAPI's CDN pages are not there."""
+    """/docs (Swagger UI) from local assets; the app is made with ``docs_url=None,
+    redoc_url=None`` so FastAPI's CDN pages are not there."""
     app.mount(ASSETS, StaticFiles(directory=assets_dir()), name="docs-assets")
     title = app.title
 
@@ -67,13 +68,6 @@ def mount_docs(app: FastAPI) -> None:
             swagger_favicon_url=f"{ASSETS}/favicon.png",
             # No badge fetched from validator.swagger.io
             swagger_ui_parameters={"validatorUrl": None}))
-
-    @app.get("/redoc", include_in_schema=False)
-    async def redoc() -> HTMLResponse:
-        return _with_csp(get_redoc_html(
-            openapi_url=app.openapi_url or "/openapi.json", title=f"{title} · API",
-            redoc_js_url=f"{ASSETS}/redoc.standalone.js",
-            redoc_favicon_url=f"{ASSETS}/favicon.png", with_google_fonts=False))
 
 
 class SecurityHeaders:
