@@ -18,7 +18,7 @@ from PIL import Image
 from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.server.api import WEB_DIR, create_app, mount_web
-from opaline.server.errors import PUBLIC_ERRORS
+from opaline.server.errors import HTTP_REASONS, PUBLIC_ERRORS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
 from worker_helpers import BrokenRenderer, EchoTask, GateTask, no_gl
@@ -58,8 +58,11 @@ def occupy(client: TestClient, folder, key: str = "gate") -> GateTask:
 
 
 def problems(response) -> list[str]:
-    detail = response.json()["detail"]
-    return detail if isinstance(detail, list) else [detail]
+    """The lines of an error answer, checking its one shape: {"error": reason, "detail": [...]}."""
+    body = response.json()
+    assert set(body) == {"error", "detail"} and isinstance(body["error"], str), body
+    assert all(isinstance(line, str) for line in body["detail"]), body
+    return body["detail"]
 
 
 # Operations
@@ -103,8 +106,8 @@ def test_metrics_exposition(client):
 
 def test_every_rejection_reason_is_exposed_from_the_start():
     """Each reason the error handlers count is on /metrics at 0 before the first rejection."""
-    counted = {reason for _, reason in PUBLIC_ERRORS.values() if reason} | {"too_large"}
-    assert counted == set(REJECT_REASONS)
+    counted = {reason for _, reason in PUBLIC_ERRORS.values()} | set(HTTP_REASONS.values())
+    assert counted | {"error"} == set(REJECT_REASONS)
 
 
 # Images
@@ -276,9 +279,9 @@ def test_bad_choice_and_bad_json_are_422(client):
     """A value outside a choice, invalid JSON and a missing body each answer 422 with one line."""
     assert "format" in problems(client.get("/v1/render?format=jpg"))[0]
     bad = client.post("/v1/render", content=b"{", headers={"content-type": "application/json"})
-    assert bad.status_code == 422 and "JSON" in problems(bad)[0]
+    assert bad.status_code == 400 and "JSON" in problems(bad)[0]
     empty = client.post("/v1/render", content=b"", headers={"content-type": "application/json"})
-    assert empty.status_code == 422
+    assert empty.status_code == 400 and "JSON object is required" in problems(empty)[0]
 
 
 def test_mdf_bad_input_is_422(client):
@@ -295,7 +298,8 @@ def test_unknown_preset_is_404_listing_presets(client):
     for response in (client.get("/v1/render?preset=teapot"), client.get("/v1/presets/teapot"),
                      client.post("/v1/render", json={"preset": "teapot"})):
         assert response.status_code == 404
-        assert "teapot" in response.json()["detail"] and "cd-rom" in response.json()["detail"]
+        (line,) = problems(response)
+        assert "teapot" in line and "cd-rom" in line and response.json()["error"] == "unknown_preset"
 
 
 def test_cost_over_budget_is_422_naming_the_budget(backend):
@@ -348,9 +352,9 @@ def test_settings_come_from_env_and_dependency_overrides(backend, monkeypatch):
     assert Settings().max_width == 100 and Settings().gl_backend == backend
     monkeypatch.delenv("OPALINE_MAX_WIDTH")
     with make_client(backend) as client:
-        assert client.get(f"/v1/render?{SMALL}&width=128").status_code == 200
+        assert client.get("/v1/render?width=128&height=64&quality=draft").status_code == 200
         client.app.dependency_overrides[get_settings] = lambda: Settings(max_width=100)
-        assert client.get(f"/v1/render?{SMALL}&width=128").status_code == 422
+        assert client.get("/v1/render?width=128&height=64&quality=draft").status_code == 422
 
 
 # Load and failure
@@ -417,7 +421,7 @@ def test_render_failure_is_500_without_the_log(backend, caplog):
     with caplog.at_level(logging.ERROR), TestClient(app) as client:
         response = client.get(f"/v1/render?{SMALL}")
         assert response.status_code == 500
-        assert "incident" in response.json()["detail"]
+        assert "incident" in problems(response)[0]
         assert "SECRET" not in response.text
         assert client.get("/healthz").status_code == 200
     assert "SECRET-COMPILE-LOG" in caplog.text

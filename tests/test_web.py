@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import shlex
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -64,9 +65,22 @@ def open_page(page, query: str = ""):
     settle(page)
 
 
+def wait_until(page, expression: str, arg=None, timeout_ms: int = WAIT_MS) -> None:
+    """Poll ``expression`` (a JS function of ``arg``) until it is true.
+
+    Playwright's wait_for_function evaluates its predicate with eval, which the pages'
+    Content-Security-Policy forbids (no 'unsafe-eval'); page.evaluate goes through the
+    DevTools protocol, which the policy does not govern."""
+    deadline = time.monotonic() + timeout_ms / 1000
+    while not page.evaluate(expression, arg):
+        if time.monotonic() > deadline:
+            raise AssertionError(f"not true within {timeout_ms} ms: {expression}")
+        time.sleep(0.05)
+
+
 def settle(page) -> None:
     """Wait until the page has no change pending and every answer is shown."""
-    page.wait_for_function("document.body.dataset.busy === 'false'", timeout=WAIT_MS)
+    wait_until(page, "() => document.body.dataset.busy === 'false'")
 
 
 def shown_bytes(page, selector: str = "#preview") -> bytes:
@@ -211,12 +225,12 @@ def test_busy_service_is_shown_and_retried(page):
             return
         refused.append(route.request.url)
         route.fulfill(status=503, headers={"Retry-After": "1"}, content_type="application/json",
-                      body='{"detail": "the render queue is full; retry later"}')
+                      body='{"error": "queue_full", "detail": ["the render queue is full; retry later"]}')
 
     page.route("**/v1/render?*", busy_once)
     page.fill("#in-mu_f", "7")
-    page.wait_for_function(
-        "document.querySelector('#err-general').textContent.includes('queue is full')")
+    wait_until(page, "() => document.querySelector('#err-general').textContent"
+                     ".includes('queue is full')")
     assert "busy" in page.text_content("#status")
     assert shown_bytes(page) == good
     settle(page)
@@ -230,9 +244,70 @@ def test_invalid_value_during_a_render_stops_the_spinner(page):
     held: list = []
     page.route("**/v1/render?*", lambda route: held.append(route))  # held: never answered
     page.fill("#in-mu_f", "7")
-    page.wait_for_function("document.body.classList.contains('loading')")
+    wait_until(page, "() => document.body.classList.contains('loading')")
     page.fill("#in-mu_f", "")
     settle(page)
     assert held and "valid value" in page.text_content("#status")
     assert not page.evaluate("document.body.classList.contains('loading')")
     page.unroute("**/v1/render?*")  # the held request was aborted by the page itself
+
+
+# Offline documentation and access control (issue 11)
+
+
+def only_the_service(page, base: str) -> tuple[list[str], list[str]]:
+    """Abort and record every request that leaves the service; record CSP violations."""
+    outside: list[str] = []
+    violations: list[str] = []
+
+    def guard(route):
+        if route.request.url.startswith(base):
+            route.continue_()
+        else:
+            outside.append(route.request.url)
+            route.abort()
+
+    page.route("**/*", guard)
+    page.on("console", lambda msg: violations.append(msg.text)
+            if "Content Security Policy" in msg.text else None)
+    return outside, violations
+
+
+def test_docs_render_with_no_network_but_the_service(page):
+    """Swagger UI comes from the service itself, under its CSP, and shows every route."""
+    outside, violations = only_the_service(page, page.base)
+    answer = page.goto(page.base + "/docs")
+    assert "frame-ancestors 'none'" in answer.headers["content-security-policy"]
+    assert answer.headers["x-content-type-options"] == "nosniff"
+    wait_until(page, "(sel) => [...document.querySelectorAll(sel)]"
+                     ".some((n) => n.textContent.includes('Opaline'))", ".swagger-ui .info .title")
+    page.wait_for_selector(".opblock-summary-path[data-path='/v1/render']", timeout=WAIT_MS)
+    assert outside == [] and violations == []
+
+
+def test_page_works_with_keys_and_signing_on(browser):
+    """With access control on, the page asks for a key, sends it as a header (never in a
+    URL), and then shows the preview as before."""
+    key = "web-key-7d2e"
+    env = {"OPALINE_API_KEYS": key, "OPALINE_SIGNING_KEY": "web-secret-19aa"}
+    try:
+        with LocalServer(workers=1, env=env, ready_path="/healthz", start_timeout_s=START_S) as local:
+            context = browser.new_context()
+            context.set_default_timeout(WAIT_MS)
+            page = context.new_page()
+            outside, violations = only_the_service(page, local.base)
+            urls: list[str] = []
+            page.on("request", lambda request: urls.append(request.url))
+            answer = page.goto(local.base + "/")
+            assert "script-src 'self'" in answer.headers["content-security-policy"]
+            page.wait_for_selector("#key-form:not([hidden])")
+            page.fill("#api-key", key)
+            page.click("#key-form button")
+            settle(page)
+            assert shown_bytes(page).startswith(b"\x89PNG")
+            assert page.locator("#key-form").is_hidden()
+            context.close()
+    except ServerError as exc:
+        pytest.fail(str(exc))
+    assert outside == [] and violations == []
+    assert not any(key in url for url in urls)

@@ -14,7 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Literal, get_args
 
-from pydantic import Field, field_validator
+from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 BackendName = Literal["egl", "osmesa", "auto"]
@@ -77,7 +77,28 @@ class Settings(BaseSettings):
         DEFAULT_COST_BUDGET, ge=1,
         description="Largest width×height×samples×max(wavelengths, 3) a request may cost.")
     max_connections: int = Field(
-        1024, ge=1, description="Open connections uvicorn accepts before answering 503.")
+        1024, ge=1, description="Open connections the service accepts before answering 503.")
+    # Access control (docs/design.md, "Access control"): off until a key or a secret is set.
+    api_keys: SecretStr | None = Field(
+        None, description="Comma-separated API keys; setting any turns access control on: /v1 "
+                          "and /metrics then need X-API-Key (or Authorization: Bearer) or, for "
+                          "GET images, a signed URL.")
+    signing_key: SecretStr | None = Field(
+        None, description="Secret for HMAC-SHA256 signed GET URLs (sig=, optional exp=); "
+                          "setting it turns access control on.")
+    rate_limit_per_s: float = Field(
+        0.0, ge=0, description="Requests per second per API key or client address (0: off); "
+                               "over it: 429 with Retry-After.")
+    rate_burst: int = Field(20, ge=1, description="Requests a key or address may burst.")
+    # Connection hygiene (opaline.server.connections)
+    header_timeout_s: float = Field(
+        10.0, gt=0, le=600, description="A connection must send a request's headers within this.")
+    body_timeout_s: float = Field(
+        10.0, gt=0, le=600, description="A request's body must arrive within this.")
+    write_timeout_s: float = Field(
+        30.0, gt=0, le=3600, description="A client that reads nothing for this long is dropped.")
+    max_connections_per_client: int = Field(
+        64, ge=1, description="Open connections one client address may hold; beyond: refused.")
     presets_dir: Path | None = Field(
         None, description="Folder of scene presets (TOML) used instead of the built-in ones.")
     warmup: bool = Field(
@@ -88,6 +109,12 @@ class Settings(BaseSettings):
     @classmethod
     def _lower(cls, value: object) -> object:
         return value.strip().lower() if isinstance(value, str) else value  # as context.py reads it
+
+
+def secrets(value: SecretStr | None) -> list[bytes]:
+    """The comma-separated secrets of a setting, as bytes for hmac."""
+    raw = value.get_secret_value() if value is not None else ""
+    return [part.strip().encode() for part in raw.split(",") if part.strip()]
 
 
 @lru_cache

@@ -1,4 +1,4 @@
-"""``opaline serve``: the HTTP service under uvicorn (one process, render worker threads)."""
+"""``opaline serve``: the HTTP service under uvicorn, on the guarded h11 protocol."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
     from opaline.cli.args import CliError
     from opaline.model.params import describe_errors
     from opaline.server.api import create_app
+    from opaline.server.connections import guarded_protocol
     from opaline.settings import Settings
 
     overrides = {"host": args.host, "port": args.port, "workers": args.workers,
@@ -28,9 +29,11 @@ def cmd_serve(args: argparse.Namespace) -> None:
     # failures with their tracebacks and shader logs) go to stderr beside them.
     logging.basicConfig(level=args.log_level.upper(),
                         format="%(levelname)s:     %(name)s: %(message)s")
+    # The guarded protocol caps connections (in all and per address) and times out slow
+    # reads and writes; uvicorn's own limit would answer a bare text/plain 503.
     uvicorn.run(create_app(settings), host=settings.host, port=settings.port,
-                log_level=args.log_level, limit_concurrency=settings.max_connections,
-                timeout_graceful_shutdown=10)
+                log_level=args.log_level, http=guarded_protocol(settings),
+                limit_concurrency=None, timeout_graceful_shutdown=10)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

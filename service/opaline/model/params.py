@@ -43,6 +43,25 @@ def wavelengths_ok(value: int | None) -> int | None:
     return value
 
 
+def wavelengths_schema(schema: dict[str, Any]) -> None:
+    """The OpenAPI bounds of ``wavelengths``, read off ``wavelengths_ok`` itself: the
+    smallest and largest accepted counts, and every refused count between them under
+    ``not``, so the document says exactly what the validator accepts, whatever it is."""
+    def ok(n: int) -> bool:
+        try:
+            wavelengths_ok(n)
+        except ValueError:
+            return False
+        return True
+
+    accepted = [n for n in range(0, 1025) if ok(n)]
+    lo, hi = accepted[0], accepted[-1]
+    refused = [n for n in range(lo, hi + 1) if not ok(n)]
+    schema.update({"minimum": lo, "maximum": hi})
+    if refused:
+        schema["not"] = {"enum": refused}
+
+
 class MaterialFields(PhysicalFields):
     """Material parameters; ``None`` means "take the preset's value"."""
 
@@ -104,7 +123,7 @@ class RenderFields(MaterialFields):
     # Bounds for UIs live in the schema; the validator gives the exact rule (0 or 3 … 128).
     wavelengths: int | None = Field(
         None,
-        json_schema_extra={"minimum": 0, "maximum": 128},
+        json_schema_extra=wavelengths_schema,
         description="0 = the paper's RGB rotations, else 3 … 128 wavelengths integrated with CIE 1931 (default: the tier's).",
     )
     aa: AntiAlias | None = Field(

@@ -18,14 +18,19 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI
 from fastapi.responses import FileResponse, RedirectResponse, Response
+from pydantic import BaseModel
 
 from opaline import __version__
 from opaline.gl.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
+from opaline.server.access import Access
 from opaline.server.cache import ImageCache
-from opaline.server.errors import Problem, install
+from opaline.server.connections import STATS as CONNECTION_STATS
+from opaline.server.docs import SecurityHeaders, mount_docs
+from opaline.server.errors import ERROR_RESPONSES, Problem, install
+from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
@@ -135,6 +140,22 @@ def renderer_for(settings: Settings) -> RendererFactory:
                            target_bytes=settings.worker_target_mb * mib)
 
 
+def document(app: FastAPI, *models: type[BaseModel]) -> None:
+    """Put ``models`` among the OpenAPI components: routes that parse their own body
+    refer to them (and the web page reads RenderRequest from there)."""
+    generate = app.openapi
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:
+            schemas = generate().setdefault("components", {}).setdefault("schemas", {})
+            for model in models:
+                schemas[model.__name__] = model.model_json_schema(
+                    ref_template="#/components/schemas/{model}")
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
+
+
 def create_app(settings: Settings | None = None, renderer_factory: Any = None) -> FastAPI:
     """The service; its lifespan starts the render workers and stops them at shutdown.
 
@@ -156,14 +177,22 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
         warmup=warmup_task() if settings.warmup else None, calibrate=settings.calibrate)
     metrics.watch(pool.depth, lambda: cache.size_bytes)
     metrics.watch_pool(pool.counters, lambda: cache.evictions)
+    metrics.watch_connections(CONNECTION_STATS)
     app = FastAPI(title="Opaline", version=__version__, lifespan=lifespan,
+                  docs_url=None, redoc_url=None,
+                  responses={k: ERROR_RESPONSES[k] for k in (403, 404, 422, 429, 500)},
                   description="Headless previews of iridescent materials "
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
     install(app, settings.max_body_bytes, metrics)
+    app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)
+    app.add_middleware(Access, settings=settings, on_reject=metrics.reject)
+    app.add_middleware(SecurityHeaders)
     app.include_router(render_router)
     app.include_router(router)
+    document(app, RenderRequest)
+    mount_docs(app)
     mount_web(app)
     return app

@@ -1,9 +1,11 @@
-"""The public face of every failure: a status, a message, and whether it is counted.
+"""The public face of every failure: one body shape, a status, and a count.
 
-422 with one line per problem, 404 for an unknown preset, 413 for a body over
-the limit, 503 with Retry-After, 500 with a pointer to the server log (the
-traceback and any shader log go only there). ``install`` puts the handlers and
-the body limit on an app.
+Every 4xx and 5xx answers ``{"error": reason, "detail": [line, ...]}``: 422 with
+one line per problem, 400 for a body that does not parse, 404 for an unknown
+preset or path, 413 for a body over the limit, 503 with Retry-After, 500 with a
+pointer to the server log (the traceback and any shader log go only there).
+Each answer is counted under its reason. ``install`` puts the handlers and the
+body limit on an app.
 """
 
 from __future__ import annotations
@@ -14,16 +16,17 @@ from typing import Any
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import JSONResponse
+from fastapi.responses import JSONResponse, Response
 from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException
+from starlette.requests import ClientDisconnect
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.presets import UnknownPreset
 from opaline.model.request import CostError
-from opaline.server.metrics import Metrics
-from opaline.server.queries import MdfQuery
+from opaline.server.metrics import REJECT_REASONS, Metrics
+from opaline.server.queries import Malformed, MdfQuery
 from opaline.workers.errors import (
     Cancelled,
     DeadlineExceeded,
@@ -42,17 +45,18 @@ class LimitError(ValueError):
         self.problems = problems
 
 
-PUBLIC_ERRORS: dict[type[Exception], tuple[int, str | None]] = {
+PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
+    Malformed: (400, "malformed"),
     UnknownPreset: (404, "unknown_preset"),
     CostError: (422, "cost"),
-    LimitError: (422, "invalid"),
+    LimitError: (422, "limit"),
     TooSlow: (422, "too_slow"),
     ValidationError: (422, "invalid"),
     Overloaded: (503, "queue_full"),
     DeadlineExceeded: (503, "deadline"),
     Unavailable: (503, "unavailable"),
     Cancelled: (503, "cancelled"),
-    RenderFailed: (500, None),
+    RenderFailed: (500, "render_failed"),
 }
 
 
@@ -60,21 +64,31 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str | None]] = {
 
 
 class Problem(BaseModel):
-    detail: str
+    """Every error answer, whatever its status."""
+
+    error: str = Field(description="Why, in one word: " + ", ".join(REJECT_REASONS) + ".")
+    detail: list[str] = Field(description="One line per problem: field, value, what is allowed.")
 
 
-class Problems(BaseModel):
-    detail: list[str] = Field(description="One line per problem: field, value, allowed range.")
-
-
+# Reasons of the errors Starlette raises itself (routing, body limit, access control).
+HTTP_REASONS = {400: "malformed", 403: "forbidden", 404: "not_found",
+                405: "method_not_allowed", 408: "timeout", 413: "too_large",
+                429: "rate_limited"}
 RETRY_AFTER = {"Retry-After": {"description": "Seconds to wait before retrying.",
                                "schema": {"type": "integer"}}}
 ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
-    422: {"model": Problems, "description": "Invalid parameters, or over a configured limit."},
+    400: {"model": Problem, "description": "The body is not a JSON document (not UTF-8, not "
+                                           "JSON, or nested too deep)."},
+    403: {"model": Problem, "description": "Access control is on and the request has no valid "
+                                           "API key or URL signature."},
+    404: {"model": Problem, "description": "Unknown preset (the message lists the valid ones) "
+                                           "or path."},
+    413: {"model": Problem, "description": "Request body too large."},
+    422: {"model": Problem, "description": "Invalid parameters, or over a configured limit."},
+    429: {"model": Problem, "description": "Over the rate limit.", "headers": RETRY_AFTER},
     503: {"model": Problem, "description": "Overloaded or no GL context.", "headers": RETRY_AFTER},
     500: {"model": Problem, "description": "The render failed (details in the server log)."},
 }
-
 
 # Handlers
 
@@ -96,32 +110,53 @@ def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> l
     return lines + describe_errors(rest, model)
 
 
-def _problem(status: int, detail: str | list[str], headers: dict[str, str] | None = None):
-    return JSONResponse({"detail": detail}, status_code=status, headers=headers)
+def problem(status: int, reason: str, detail: str | list[str],
+            headers: dict[str, str] | None = None) -> JSONResponse:
+    """The one error body: ``{"error": reason, "detail": [lines]}``."""
+    lines = [detail] if isinstance(detail, str) else detail
+    return JSONResponse({"error": reason, "detail": lines}, status_code=status, headers=headers)
 
 
 async def on_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
     request.app.state.metrics.reject("invalid")
     model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
-    return _problem(422, _validation_lines(list(exc.errors()), model))
+    return problem(422, "invalid", _validation_lines(list(exc.errors()), model))
 
 
 async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
     status, reason = next(v for k, v in PUBLIC_ERRORS.items() if isinstance(exc, k))
     state = request.app.state
-    if reason:
-        state.metrics.reject(reason)
+    state.metrics.reject(reason)
     if isinstance(exc, ValidationError):
-        return _problem(status, describe_errors(exc))
+        return problem(status, reason, describe_errors(exc))
     if isinstance(exc, LimitError):
-        return _problem(status, exc.problems)
+        return problem(status, reason, exc.problems)
     if isinstance(exc, RenderFailed):
-        return _problem(status, f"{exc}: the details are in the server log")
+        return problem(status, reason, f"{exc}: the details are in the server log")
     if status == 503:
         wait = getattr(exc, "retry_after_s", state.settings.retry_after_s)
         retry = str(max(state.settings.retry_after_s, math.ceil(wait)))
-        return _problem(status, f"{exc}; retry later", headers={"Retry-After": retry})
-    return _problem(status, [str(exc)] if status == 422 else str(exc))
+        return problem(status, reason, f"{exc}; retry later", headers={"Retry-After": retry})
+    return problem(status, reason, str(exc))
+
+
+async def on_http_error(request: Request, exc: HTTPException) -> JSONResponse:
+    """Starlette's own errors (404, 405 with its Allow, 413 while streaming) in the same shape."""
+    reason = HTTP_REASONS.get(exc.status_code, "invalid" if exc.status_code < 500 else "error")
+    request.app.state.metrics.reject(reason)
+    return problem(exc.status_code, reason, str(exc.detail), headers=exc.headers)
+
+
+async def on_gone(request: Request, exc: ClientDisconnect) -> Response:
+    """The client left (or was dropped for a slow body) while its body was read: no one to
+    answer, nothing to log."""
+    return Response(status_code=400)
+
+
+async def on_crash(request: Request, exc: Exception) -> JSONResponse:
+    """A bug: 500 in the public shape; the traceback goes to the log (Starlette logs it)."""
+    request.app.state.metrics.reject("error")
+    return problem(500, "error", "internal error: the details are in the server log")
 
 
 class BodyLimit:
@@ -130,9 +165,10 @@ class BodyLimit:
     def __init__(self, app: ASGIApp, limit: int, on_reject: Any) -> None:
         self.app, self.limit, self.on_reject = app, limit, on_reject
 
-    def _refuse(self) -> str:
-        """Count the rejection; the message to answer it with."""
-        self.on_reject()
+    def _refuse(self, count: bool = True) -> str:
+        """Count the rejection (unless the error handler will); the message to answer it with."""
+        if count:
+            self.on_reject()
         return f"request body over the {self.limit} byte limit"
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
@@ -141,7 +177,7 @@ class BodyLimit:
             return
         declared = dict(scope["headers"]).get(b"content-length", b"")
         if declared.isdigit() and int(declared) > self.limit:
-            await _problem(413, self._refuse())(scope, receive, send)
+            await problem(413, "too_large", self._refuse())(scope, receive, send)
             return
         seen = 0
 
@@ -150,8 +186,8 @@ class BodyLimit:
             message = await receive()
             seen += len(message.get("body", b""))
             if seen > self.limit:
-                # FastAPI re-raises HTTPException from its body reader
-                raise HTTPException(413, self._refuse())
+                # The route's body reader re-raises it; on_http_error answers and counts it
+                raise HTTPException(413, self._refuse(count=False))
             return message
 
         await self.app(scope, counted, send)
@@ -162,5 +198,8 @@ def install(app: FastAPI, max_body_bytes: int, metrics: Metrics) -> None:
     app.add_middleware(BodyLimit, limit=max_body_bytes,
                        on_reject=partial(metrics.reject, "too_large"))
     app.add_exception_handler(RequestValidationError, on_invalid)
+    app.add_exception_handler(HTTPException, on_http_error)
+    app.add_exception_handler(ClientDisconnect, on_gone)
+    app.add_exception_handler(Exception, on_crash)
     for exc_type in PUBLIC_ERRORS:
         app.add_exception_handler(exc_type, on_public_error)

@@ -45,7 +45,8 @@ class LocalServer:
     """A real uvicorn process; ready once ``ready_path`` answers 200, stopped on exit."""
 
     def __init__(self, workers: int = 1, env: dict[str, str] | None = None,
-                 ready_path: str = "/readyz", start_timeout_s: float = 60.0) -> None:
+                 ready_path: str = "/readyz", start_timeout_s: float = 60.0,
+                 log_level: str = "warning") -> None:
         self.port = free_port()
         self.base = f"http://{HOST}:{self.port}"
         self.ready_path = ready_path
@@ -54,7 +55,7 @@ class LocalServer:
         self.log = tempfile.TemporaryFile("w+")
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "opaline.cli.main", "serve", "--host", HOST, "--port",
-             str(self.port), "--workers", str(workers), "--log-level", "warning"],
+             str(self.port), "--workers", str(workers), "--log-level", log_level],
             cwd=ROOT, env=loopback_env(**(env or {})), stdout=self.log, stderr=subprocess.STDOUT)
 
     def log_text(self, last: int = 3000) -> str:

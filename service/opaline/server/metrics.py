@@ -23,8 +23,9 @@ from prometheus_client.registry import Collector
 # seconds (reference tier at 2048²).
 RENDER_BUCKETS = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 30.0, 60.0)
 
-REJECT_REASONS = ("invalid", "unknown_preset", "cost", "too_slow", "too_large", "queue_full",
-                  "deadline", "unavailable", "cancelled")
+REJECT_REASONS = ("invalid", "malformed", "unknown_preset", "not_found", "method_not_allowed",
+                  "cost", "too_slow", "too_large", "queue_full", "deadline", "unavailable",
+                  "cancelled", "forbidden", "rate_limited", "timeout", "render_failed", "error", "limit")
 # The worker pool's own counters, exported as they stand at scrape time.
 POOL_COUNTERS = {
     "restarts_crash": ("opaline_worker_restarts", "Worker processes replaced, by reason.",
@@ -88,6 +89,10 @@ class Metrics:
         evictions at scrape time."""
         self.registry.register(_PoolCollector(counters, image_evictions))
 
+    def watch_connections(self, stats: Mapping[str, int]) -> None:
+        """Export the connection layer's refusals and timeouts (opaline.server.connections)."""
+        self.registry.register(_ConnectionCollector(stats))
+
     def reject(self, reason: str) -> None:
         self.rejected.labels(reason).inc()
 
@@ -111,3 +116,24 @@ class _PoolCollector(Collector):
                                      "Images evicted from the HTTP process's cache.")
         images.add_metric([], self.image_evictions())
         yield images
+
+
+class _ConnectionCollector(Collector):
+    def __init__(self, stats: Mapping[str, int]) -> None:
+        self.stats = stats
+
+    def collect(self) -> Iterator[CounterMetricFamily]:
+        refused = CounterMetricFamily("opaline_connections_refused",
+                                      "Connections refused at once, by cap.", labels=["cap"])
+        for cap in ("connections", "per_client"):
+            refused.add_metric([cap], self.stats.get("refused_" + cap, 0))
+        malformed = CounterMetricFamily("opaline_malformed_http",
+                                        "Requests that were not valid HTTP/1.1 (answered 400).")
+        malformed.add_metric([], self.stats.get("malformed", 0))
+        yield malformed
+        timeouts = CounterMetricFamily("opaline_connection_timeouts",
+                                       "Connections closed for a slow client.", labels=["kind"])
+        for kind in ("header", "body", "write"):
+            timeouts.add_metric([kind], self.stats.get(kind + "_timeouts", 0))
+        yield refused
+        yield timeouts

@@ -6,11 +6,20 @@ parameter repeated three times); every other field is the request model's own.
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from functools import cache
+from typing import Any, Literal, TypeVar
 
-from pydantic import Field, field_validator
+from pydantic import BaseModel, Field, field_validator
+from pydantic_core import from_json, to_json
 
-from opaline.model.params import MaterialFields, Pixels, RenderRequest, Unit, wavelengths_ok
+from opaline.model.params import (
+    MaterialFields,
+    Pixels,
+    RenderRequest,
+    Unit,
+    wavelengths_ok,
+    wavelengths_schema,
+)
 
 
 def _comma_list(value: Any) -> Any:
@@ -39,8 +48,47 @@ class MdfQuery(MaterialFields):
         "png", description="'png' (normalised by the maximum, sRGB) or 'npy' (linear D, float32).")
     # As RenderFields.wavelengths: bounds for the schema, the exact rule in the validator.
     wavelengths: int = Field(
-        0, json_schema_extra={"minimum": 0, "maximum": 128},
+        0, json_schema_extra=wavelengths_schema,
         description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
 
     _albedo = field_validator("albedo", mode="before")(_comma_list)
     _wavelengths = field_validator("wavelengths")(wavelengths_ok)
+
+
+class Malformed(ValueError):
+    """A body that is not a JSON document: not UTF-8, not JSON, or nested too deep (400)."""
+
+
+Model = TypeVar("Model", bound=BaseModel)
+
+
+def parse_body(raw: bytes, model: type[Model]) -> Model:
+    """A JSON body as ``model``, strictly: numbers must be JSON numbers and booleans JSON
+    booleans, as the OpenAPI document says ({"mu_f": "6"} and {"mu_f": false} are refused);
+    an integer field takes an integral number written as a float (178.0), as JSON Schema's
+    "integer" does. pydantic's parser bounds the nesting depth; a parse failure is
+    ``Malformed``."""
+    if not raw.strip():
+        raise Malformed("body: a JSON object is required ({} renders the defaults)")
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise Malformed(f"body: not valid UTF-8 (byte {exc.start})") from None
+    try:
+        data = from_json(raw)
+    except ValueError as exc:
+        raise Malformed(f"body: not valid JSON ({exc})") from None
+    if isinstance(data, dict):
+        for name in integer_fields(model) & data.keys():
+            value = data[name]
+            if isinstance(value, float) and value.is_integer():
+                data[name] = int(value)
+    return model.model_validate_json(to_json(data, inf_nan_mode="constants"), strict=True)
+
+
+@cache
+def integer_fields(model: type[BaseModel]) -> frozenset[str]:
+    """The fields whose JSON type is integer (alone or beside null)."""
+    props = model.model_json_schema()["properties"]
+    return frozenset(name for name, prop in props.items()
+                     if "integer" in {alt.get("type") for alt in prop.get("anyOf", [prop])})

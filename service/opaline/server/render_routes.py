@@ -30,8 +30,9 @@ from opaline.server.canonical import (
     mdf_url,
 )
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
-from opaline.server.queries import MdfQuery
+from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.service import Service, get_service
+from opaline.server.streaming import image_response
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
@@ -84,7 +85,7 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
         data = await svc.pool.render(key, task, timeout=svc.wait_s, gone=client_gone(request))
     headers["ETag"] = svc.cache.tag(key) or etag(data)
     headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
-    return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
+    return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
 async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
@@ -130,10 +131,16 @@ MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
 router = APIRouter()
 
 
+# The body is parsed strictly by parse_body (numbers are JSON numbers), so the route
+# documents it itself instead of letting FastAPI parse it laxly.
+BODY = {"requestBody": {"required": True, "content": {
+    "application/json": {"schema": {"$ref": "#/components/schemas/RenderRequest"}}}}}
+
+
 @router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
-             summary="Render a preset with material overrides (JSON body)")
-async def render_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, body)
+             summary="Render a preset with material overrides (JSON body)", openapi_extra=BODY)
+async def render_post(request: Request, svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, parse_body(await request.body(), RenderRequest))
 
 
 @router.get("/v1/render", tags=["render"], response_class=Response,

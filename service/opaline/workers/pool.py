@@ -78,9 +78,10 @@ class WorkerPool:
                       "; ".join(s.error or s.state for s in self.slots))
             return
         tasks = [self.warmup, CalibrateTask() if self.calibrate else None]
-        with self._cond:  # first in the queue, never expiring
+        with self._cond:  # first in the queue, never expiring, counted in the backlog
             for task in filter(None, tasks):
-                self._enqueue(Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf, 0))
+                self._enqueue(Job(next(self._ids), uuid.uuid4().hex, task, task.label,
+                                  math.inf, self.cost.predict(*task.units())))
 
     def stop(self, timeout: float = 10.0) -> None:
         """Refuse new jobs, fail the queued ones, and let each worker release its context."""
@@ -99,8 +100,6 @@ class WorkerPool:
 
     def wait_stop(self, seconds: float) -> None:
         self._stop.wait(seconds)
-
-    # Submitting
 
     def submit(self, key: str, task: Task, label: str = "") -> Job:
         """The job under ``key``: joined if in flight, else admitted and queued."""

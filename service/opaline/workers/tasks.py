@@ -108,4 +108,8 @@ class CalibrateTask:
         return time.perf_counter() - start
 
     def units(self) -> tuple[str, float, int]:
-        return "calibration", 0.0, 0
+        """Four renders per preset (a warm-up and a timing at each of two wavelength
+        counts), half of them spectral: so admission counts the work ahead of a request."""
+        per_render = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
+        return ("calibration", 4.0 * len(all_presets()) * per_render,
+                CALIBRATION_WAVELENGTHS // 2)

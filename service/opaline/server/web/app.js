@@ -49,6 +49,9 @@
   const LIGHT_FALLBACK = { light_azimuth: 0, light_elevation: 45 };
   const EXTENSIONS = { png: '.png', png16: '.png', npy: '.npy' };
   const BOOLEANS = new Map([['true', true], ['1', true], ['false', false], ['0', false]]);
+  // With access control on, the service wants an API key; the page keeps the one the user
+  // types for this tab only (sessionStorage) and sends it as a header, never in a URL.
+  const KEY_STORE = 'opaline-api-key';
 
   const $ = (sel) => document.querySelector(sel);
   const state = {
@@ -93,8 +96,26 @@
     return /^[\w@%+=:,./-]+$/.test(text) ? text : `'${text.replace(/'/g, `'\\''`)}'`;
   }
 
+  function authHeaders() {
+    const key = sessionStorage.getItem(KEY_STORE);
+    return key ? { 'X-API-Key': key } : {};
+  }
+
+  // A 403 means access control is on: ask for a key; saving it reloads the page.
+  function askForKey() {
+    const form = $('#key-form');
+    if (!form || !form.hidden) return;
+    form.hidden = false;
+    form.addEventListener('submit', (event) => {
+      event.preventDefault();
+      sessionStorage.setItem(KEY_STORE, $('#api-key').value.trim());
+      location.reload();
+    });
+  }
+
   async function getJSON(url) {
-    const resp = await fetch(url);
+    const resp = await fetch(url, { headers: authHeaders() });
+    if (resp.status === 403) askForKey();
     const body = await resp.json().catch(() => null);
     if (!resp.ok) {
       throw Object.assign(new Error(problemLines(body, resp).join('\n')), { status: resp.status });
@@ -470,12 +491,13 @@
     if (img.dataset.url === url) return { ok: true, url, kept: true };
     let resp;
     try {
-      resp = await fetch(url, { signal });
+      resp = await fetch(url, { signal, headers: authHeaders() });
     } catch (err) {
       if (err.name === 'AbortError') return { aborted: true };
       return { ok: false, status: 0, lines: ['Cannot reach the service: ' + err.message] };
     }
     if (!resp.ok) {
+      if (resp.status === 403) askForKey();
       const body = await resp.json().catch(() => null);
       return {
         ok: false, status: resp.status, retryAfter: Number(resp.headers.get('Retry-After')) || 1,
@@ -634,7 +656,8 @@
     const file = state.preset + (EXTENSIONS[valueOf('format')] || '.png');
     const endpoint = new URL(API.render, location.href).toString();
     $('#copy-json').value = JSON.stringify(body, null, 2);
-    $('#copy-curl').value = ['curl', '-fsS', shellQuote(endpoint),
+    const keyArgs = sessionStorage.getItem(KEY_STORE) ? ['-H', '"X-API-Key: $OPALINE_API_KEY"'] : [];
+    $('#copy-curl').value = ['curl', '-fsS', shellQuote(endpoint), ...keyArgs,
       '-H', shellQuote('Content-Type: application/json'),
       '-d', shellQuote(JSON.stringify(body)), '-o', shellQuote(file)].join(' ');
     $('#copy-cli').value = cliCommand(fields, file);

@@ -1,0 +1,83 @@
+"""HEAD and OPTIONS for every route, and one value per query parameter.
+
+FastAPI routes answer only the methods they declare, so HEAD and OPTIONS got
+405 (and the 405's Allow named only POST on /v1/render). This middleware
+answers HEAD as the GET it mirrors (the server drops the body, the headers stay)
+and OPTIONS with 204 and the path's Allow, read from the app's own routes.
+
+A query string may repeat a name; pydantic keeps the last value, so
+``mu_f=2000&mu_f=1`` rendered while the other order was refused. A repeated
+scalar parameter is now a 422 naming it; only the colours (``albedo=R&albedo=G&
+albedo=B``) may repeat.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from urllib.parse import parse_qsl
+
+from starlette.responses import Response
+from starlette.routing import Match, Mount
+from starlette.types import ASGIApp, Receive, Scope, Send
+
+from opaline.server.errors import problem
+
+REPEATABLE = frozenset({"albedo"})
+PROBED = ("GET", "POST", "PUT", "PATCH", "DELETE")
+
+
+def allowed_methods(app: ASGIApp, scope: Scope) -> set[str]:
+    """The methods some route of ``app`` answers on this path (HEAD with GET, OPTIONS always).
+
+    Asked of the routes themselves, one method at a time, so included routers count."""
+    methods: set[str] = set()
+    for route in app.router.routes:  # type: ignore[attr-defined]
+        if isinstance(route, Mount):  # static files: GET (and HEAD) whatever the method
+            if route.matches(scope)[0] is not Match.NONE:
+                methods.add("GET")
+            continue
+        methods |= {m for m in PROBED if route.matches({**scope, "method": m})[0] is Match.FULL}
+    if "GET" in methods:
+        methods.add("HEAD")
+    return methods | {"OPTIONS"} if methods else methods
+
+
+def repeated(query_string: bytes) -> list[str]:
+    """One line per scalar parameter given more than once."""
+    counts = Counter(name for name, _ in parse_qsl(query_string.decode("latin-1"),
+                                                   keep_blank_values=True))
+    return [f"{name}: given {n} times; give each parameter once"
+            for name, n in counts.items() if n > 1 and name not in REPEATABLE]
+
+
+class Methods:
+    def __init__(self, app: ASGIApp, routes_of: ASGIApp, on_reject) -> None:
+        self.app, self.routes_of, self.on_reject = app, routes_of, on_reject
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        method = scope["method"]
+        if method in ("HEAD", "OPTIONS"):
+            allowed = allowed_methods(self.routes_of, scope)
+            if method == "OPTIONS" and allowed:
+                allow = ", ".join(sorted(allowed))
+                await Response(status_code=204, headers={"Allow": allow})(scope, receive, send)
+                return
+            if method == "HEAD" and "GET" in allowed:
+                scope = {**scope, "method": "GET"}
+        elif method not in ("GET", "POST"):
+            # Starlette's 405 names only the first route's methods (POST on /v1/render)
+            allowed = allowed_methods(self.routes_of, scope)
+            if allowed and method not in allowed:
+                self.on_reject("method_not_allowed")
+                await problem(405, "method_not_allowed", f"{method} is not allowed here",
+                              headers={"Allow": ", ".join(sorted(allowed))})(scope, receive, send)
+                return
+        lines = repeated(scope.get("query_string", b""))
+        if lines:
+            self.on_reject("invalid")
+            await problem(422, "invalid", lines)(scope, receive, send)
+            return
+        await self.app(scope, receive, send)
