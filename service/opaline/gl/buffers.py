@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset, build_assets
 
 TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
@@ -79,6 +80,9 @@ class SceneGPU:
 
     def __init__(self, ctx: moderngl.Context, preset: Preset) -> None:
         mesh, normal_map = build_assets(preset)
+        # A user's mesh is framed by the camera: its bounds, kept from the upload.
+        self.bounds = ((mesh.positions.min(axis=0), mesh.positions.max(axis=0))
+                       if is_mesh(preset) else None)
         self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
         self.normal_map = None

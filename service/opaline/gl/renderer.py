@@ -15,7 +15,13 @@ import numpy as np
 
 from opaline.gl import uniforms
 from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
-from opaline.gl.camera import model_matrix, place_key_light, view_projection
+from opaline.gl.camera import (
+    fit_matrix,
+    model_matrix,
+    place_key_light,
+    view_camera,
+    view_projection,
+)
 from opaline.gl.context import GLContext, create_context
 from opaline.gl.probes import Probes
 from opaline.gl.shaders import ProgramCache
@@ -155,13 +161,19 @@ class Renderer(Probes):
             preset.lights, preset.camera.target, job.light_azimuth, job.light_elevation
         )
         model = model_matrix(preset.rotation_deg)
+        if scene.bounds is not None:
+            model = fit_matrix(scene.bounds, preset.camera.target) @ model
+        camera = view_camera(preset.camera, width / height, scene.bounds is not None,
+                             job.camera_azimuth, job.camera_elevation, job.camera_distance)
+        normal_matrix = np.linalg.inv(model[:3, :3]).T
+        normal_matrix /= abs(np.linalg.det(normal_matrix)) ** (1.0 / 3.0)  # unit normals stay ~unit
         values = uniforms.material_uniforms(job.material, job.wavelengths)
         values.update(
             {
                 "u_model": model.astype("f4"),
-                "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
-                "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
-                "u_eye": tuple(preset.camera.eye),
+                "u_normal_matrix": normal_matrix.astype("f4"),
+                "u_view_proj": view_projection(camera, width / height).astype("f4"),
+                "u_eye": tuple(camera.eye),
                 "u_light_position": [
                     (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights
                 ],

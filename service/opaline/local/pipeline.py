@@ -10,14 +10,17 @@ One LocalRenderer owns one GL context; use it from the thread that made it.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
 from opaline.gl.renderer import Renderer
 from opaline.model.params import Material, RenderRequest
-from opaline.model.presets import get_preset
+from opaline.model.meshes import file_digest, mesh_preset
+from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import encode_frame, encode_mdf
+from opaline.scene.meshfile import MeshError
 from opaline.settings import get_settings
 
 
@@ -34,6 +37,7 @@ class LocalRenderer:
     def __init__(self, backend: str | None = None, cost_budget: int | None = None) -> None:
         self.renderer = Renderer(backend)
         self.cost_budget = cost_budget  # None: OPALINE_COST_BUDGET, as in the HTTP service
+        self._mesh_presets: dict[str, Preset] = {}  # jobs name presets; these are not files
 
     @property
     def budget(self) -> int:
@@ -48,13 +52,26 @@ class LocalRenderer:
     def close(self) -> None:
         self.renderer.release()
 
+    def preset(self, request: RenderRequest) -> Preset:
+        """The request's preset, drawing the request's mesh file if it names one."""
+        preset = get_preset(request.preset)
+        if request.mesh is None:
+            return preset
+        path = Path(request.mesh).expanduser()
+        if not path.is_file():
+            raise MeshError(f"mesh={request.mesh!r}: no such file")
+        preset = mesh_preset(preset, path.resolve(), file_digest(path), request,
+                             get_settings().mesh_max_triangles)
+        self._mesh_presets[preset.name] = preset
+        return preset
+
     def job(self, request: RenderRequest) -> Job:
-        job = resolve(request, get_preset(request.preset))
+        job = resolve(request, self.preset(request))
         check_cost(job, self.budget)
         return job
 
     def render_job(self, job: Job) -> bytes:
-        frame = self.renderer.render(job)
+        frame = self.renderer.render(job, self._mesh_presets.get(job.preset))
         return encode_frame(frame, job.format, alpha=job.transparent)
 
     def render_bytes(self, request: RenderRequest) -> bytes:
@@ -63,7 +80,7 @@ class LocalRenderer:
     def render_array(self, request: RenderRequest) -> np.ndarray:
         """Linear, premultiplied RGBA float32 (H, W, 4)."""
         job = replace(self.job(request), format="npy")
-        linear = self.renderer.render(job).linear
+        linear = self.renderer.render(job, self._mesh_presets.get(job.preset)).linear
         assert linear is not None  # an npy job always reads back linear radiance
         return linear
 
