@@ -92,15 +92,14 @@ def framing_distance(radius: float, fov_deg: float, aspect: float) -> float:
     return FRAME_MARGIN * radius / math.sin(half)
 
 
-def fit_matrix(bounds: tuple, target) -> np.ndarray:
-    """Row-vector model matrix that moves a mesh's bounding sphere onto a unit sphere at
-    ``target``: a user's mesh then sits where the preset's lights and camera expect an
-    object, whatever units it was modelled in (mm, m, or a 1e4-wide scan)."""
-    lo, hi = (np.asarray(b, dtype=np.float64) for b in bounds)
-    radius = max(float(np.linalg.norm(hi - lo)) * 0.5, 1e-30)
+def fit_matrix(sphere: tuple, target) -> np.ndarray:
+    """Row-vector model matrix that moves a mesh's bounding sphere (centre, radius) onto a
+    unit sphere at ``target``: a user's mesh then sits where the preset's lights and camera
+    expect an object, whatever units it was modelled in (mm, m, or a 1e4-wide scan)."""
+    centre, radius = np.asarray(sphere[0], dtype=np.float64), max(float(sphere[1]), 1e-30)
     fit = np.eye(4)
     fit[:3, :3] /= radius
-    fit[3, :3] = (np.asarray(target, dtype=np.float64) - (lo + hi) * 0.5 / radius)
+    fit[3, :3] = np.asarray(target, dtype=np.float64) - centre / radius
     return fit
 
 

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from opaline.gl.renderer import Renderer
-from opaline.model.params import Material, RenderRequest
 from opaline.model.meshes import file_digest, mesh_preset
+from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import encode_frame, encode_mdf
@@ -37,7 +37,6 @@ class LocalRenderer:
     def __init__(self, backend: str | None = None, cost_budget: int | None = None) -> None:
         self.renderer = Renderer(backend)
         self.cost_budget = cost_budget  # None: OPALINE_COST_BUDGET, as in the HTTP service
-        self._mesh_presets: dict[str, Preset] = {}  # jobs name presets; these are not files
 
     @property
     def budget(self) -> int:
@@ -52,6 +51,12 @@ class LocalRenderer:
     def close(self) -> None:
         self.renderer.release()
 
+    @property
+    def mesh_presets(self) -> dict[str, Preset]:
+        """Presets made for mesh files: jobs name their preset, and these are in no folder
+        (made on first use, so subclasses that skip ``__init__`` still have one)."""
+        return self.__dict__.setdefault("_mesh_presets", {})
+
     def preset(self, request: RenderRequest) -> Preset:
         """The request's preset, drawing the request's mesh file if it names one."""
         preset = get_preset(request.preset)
@@ -62,7 +67,7 @@ class LocalRenderer:
             raise MeshError(f"mesh={request.mesh!r}: no such file")
         preset = mesh_preset(preset, path.resolve(), file_digest(path), request,
                              get_settings().mesh_max_triangles)
-        self._mesh_presets[preset.name] = preset
+        self.mesh_presets[preset.name] = preset
         return preset
 
     def job(self, request: RenderRequest) -> Job:
@@ -71,7 +76,7 @@ class LocalRenderer:
         return job
 
     def render_job(self, job: Job) -> bytes:
-        frame = self.renderer.render(job, self._mesh_presets.get(job.preset))
+        frame = self.renderer.render(job, self.mesh_presets.get(job.preset))
         return encode_frame(frame, job.format, alpha=job.transparent)
 
     def render_bytes(self, request: RenderRequest) -> bytes:
@@ -80,7 +85,7 @@ class LocalRenderer:
     def render_array(self, request: RenderRequest) -> np.ndarray:
         """Linear, premultiplied RGBA float32 (H, W, 4)."""
         job = replace(self.job(request), format="npy")
-        linear = self.renderer.render(job, self._mesh_presets.get(job.preset)).linear
+        linear = self.renderer.render(job, self.mesh_presets.get(job.preset)).linear
         assert linear is not None  # an npy job always reads back linear radiance
         return linear
 

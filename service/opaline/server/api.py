@@ -27,6 +27,8 @@ from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
 from opaline.server.cache import ImageCache
 from opaline.server.errors import Problem, install
+from opaline.server.mesh_routes import router as mesh_router
+from opaline.server.meshstore import MeshStore
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
@@ -165,8 +167,10 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
-    install(app, settings.max_body_bytes, metrics)
+    app.state.meshes = MeshStore(settings)
+    install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
     app.include_router(render_router)
+    app.include_router(mesh_router)
     app.include_router(router)
     mount_web(app)
     return app

@@ -78,6 +78,9 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
 
 async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
     preset = get_preset(params.preset)
+    if params.mesh is not None:
+        preset = request.app.state.meshes.preset(params, preset,
+                                                 svc.settings.mesh_max_triangles)
     job = resolve(params, preset)
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
