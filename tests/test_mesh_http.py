@@ -112,3 +112,11 @@ def test_http_process_never_imports_a_mesh_parser():
             "create_app(Settings(warmup=False, calibrate=False))\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.gl
+def test_environment_over_http(client):
+    lit = client.get(f"/v1/render?preset=sphere&environment=sky&environment_lights=8&{SMALL}")
+    assert lit.status_code == 200 and lit.content.startswith(b"\x89PNG")
+    unknown = client.get(f"/v1/render?preset=sphere&environment=../x.hdr&{SMALL}")
+    assert unknown.status_code == 422 and "not known" in unknown.json()["detail"][0]

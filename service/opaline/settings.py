@@ -91,6 +91,8 @@ class Settings(BaseSettings):
         None, description="Where uploaded meshes are kept (default: a temporary folder).")
     meshes_dir: Path | None = Field(
         None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
+    environments_dir: Path | None = Field(
+        None, description="A folder of HDR environments (.hdr, .exr) requests may name.")
     warmup: bool = Field(
         True, description="Render a tiny image on each worker at start-up, so the first "
                           "request does not pay for shader compilation.")

@@ -25,10 +25,12 @@ from opaline.model.params import RenderRequest
 from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
 from opaline.resources import PRESETS_ENV, presets_dir
+from opaline.scene.environments import EnvironmentMapError
 from opaline.scene.meshfile import MeshError
 
 log = logging.getLogger("opaline.cli")
-USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError)
+USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
+                EnvironmentMapError)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
 USES_PRESETS = ("render", "presets", "batch", "gallery", "serve")
 

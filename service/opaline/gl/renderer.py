@@ -18,11 +18,11 @@ from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Target
 from opaline.gl.camera import (
     fit_matrix,
     model_matrix,
-    place_key_light,
     view_camera,
     view_projection,
 )
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.lighting import light_uniforms
 from opaline.gl.probes import Probes
 from opaline.gl.shaders import ProgramCache
 from opaline.lru import BudgetLRU
@@ -155,11 +155,10 @@ class Renderer(Probes):
             # AA stays as the job asks: it is a quality choice, not a scene feature.
             defines.update(DIFFUSE=True, FRESNEL=True, NORMAL_MAP=True)
             normal_map = normal_map or self.flat_normal_map()
-        program = self.programs.get("surface.glsl", defines)
         width, height = targets.size
-        lights = place_key_light(
-            preset.lights, preset.camera.target, job.light_azimuth, job.light_elevation
-        )
+        lights = light_uniforms(job, preset)
+        defines["LIGHT_COUNT"] = len(lights["u_light_position"])
+        program = self.programs.get("surface.glsl", defines)
         model = model_matrix(preset.rotation_deg)
         if scene.bounds is not None:
             model = fit_matrix(scene.bounds, preset.camera.target) @ model
@@ -174,10 +173,7 @@ class Renderer(Probes):
                 "u_normal_matrix": normal_matrix.astype("f4"),
                 "u_view_proj": view_projection(camera, width / height).astype("f4"),
                 "u_eye": tuple(camera.eye),
-                "u_light_position": [
-                    (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights
-                ],
-                "u_light_irradiance": [tuple(light.irradiance) for light in lights],
+                **lights,
                 "u_ambient": tuple(preset.ambient),
                 "u_aa_scale": 1.0 / np.sqrt(len(offsets)),
             }

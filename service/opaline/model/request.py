@@ -65,6 +65,10 @@ class Job:
     camera_azimuth: float | None = None
     camera_elevation: float | None = None
     camera_distance: float | None = None
+    environment: str | None = None
+    environment_rotation: float | None = None
+    environment_intensity: float | None = None
+    environment_lights: int | None = None
 
     @property
     def cost(self) -> int:

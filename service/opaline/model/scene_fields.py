@@ -44,3 +44,15 @@ class SceneFields(BaseModel):
     camera_distance: Annotated[float, Field(ge=0.2, le=10.0)] | None = Field(
         None, description="Camera distance as a multiple of the preset's (or, for a mesh, of "
                           "the distance that frames its bounds), 0.2 … 10 (default 1).")
+
+    environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
+        None, description="Light the scene with an environment instead of the preset's lights: "
+                          "'studio', 'sky', or an .hdr/.exr file of the environments folder.")
+    environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
+        None, description="Turns the environment about the up axis, degrees (default 0).")
+    environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(
+        None, description="Multiplies the environment's radiance, 0 … 1000 (default 1).")
+    environment_lights: Annotated[int, Field(ge=1, le=256)] | None = Field(
+        None, description="K: directional lights the environment becomes by median cut, "
+                          "1 … 256 (default: the tier's: draft 8, standard 16, high 32, "
+                          "reference 64).")

@@ -18,11 +18,13 @@ from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
+from opaline.scene.environments import EnvironmentMapError, check_name
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
 from opaline.server.queries import MdfQuery, RenderQuery
 from opaline.server.service import Service, get_service
 from opaline.settings import Settings
+from opaline.workers.errors import InvalidInput
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -81,6 +83,11 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
     if params.mesh is not None:
         preset = request.app.state.meshes.preset(params, preset,
                                                  svc.settings.mesh_max_triangles)
+    if params.environment is not None:
+        try:
+            check_name(params.environment, svc.settings.environments_dir)
+        except EnvironmentMapError as exc:
+            raise InvalidInput(str(exc)) from None
     job = resolve(params, preset)
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())

@@ -90,6 +90,7 @@ def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None
 def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
     from opaline.gl.renderer import Cancelled
     from opaline.gl.shaders import ShaderError
+    from opaline.scene.environments import EnvironmentMapError
     from opaline.scene.meshfile import MeshError
 
     def should_stop() -> bool:
@@ -112,7 +113,7 @@ def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
             reply.kind, reply.error = "cancelled", str(exc)
         except ShaderError as exc:
             reply.kind, reply.error = "shader", str(exc)
-        except MeshError as exc:  # the user's file, not the worker, is broken
+        except (MeshError, EnvironmentMapError) as exc:  # the user's file, not the worker
             reply.kind, reply.error = "invalid", str(exc)
         except Exception:  # GL errors, lost contexts, anything the draw raised
             reply.kind, reply.error = "crash", traceback.format_exc()
