@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from opaline import __version__
-from opaline.cli import batch, gallery, render, schema, serve
+from opaline.cli import batch, gallery, render, schema, serve, turntable
 from opaline.cli.args import CliError
 from opaline.model.material_file import MaterialError
 from opaline.model.params import RenderRequest
@@ -32,7 +32,7 @@ log = logging.getLogger("opaline.cli")
 USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
                 EnvironmentMapError)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
-USES_PRESETS = ("render", "presets", "batch", "gallery", "serve")
+USES_PRESETS = ("render", "presets", "batch", "gallery", "serve", "turntable")
 
 
 def cmd_presets(args: argparse.Namespace) -> None:
@@ -101,7 +101,7 @@ def make_parser() -> argparse.ArgumentParser:
     render.add_common(info)
     info.set_defaults(func=cmd_info)
 
-    for module in (gallery, serve, batch, schema):
+    for module in (gallery, serve, batch, schema, turntable):
         module.register(sub)
     for name, command in sub.choices.items():
         add_global(command, presets=name in USES_PRESETS)

@@ -7,6 +7,7 @@ import math
 import numpy as np
 from pyrr import Matrix44
 
+from opaline.model.meshes import MESH_VIEW
 from opaline.model.presets import Camera, Light
 
 
@@ -75,7 +76,6 @@ def place_key_light(
 
 
 # Orbit and framing. Angles as the key light's: azimuth atan2(z, x), elevation above y = 0.
-MESH_VIEW = (60.0, 20.0)  # a three-quarter view from above for meshes without a preset view
 FRAME_MARGIN = 1.08  # the bounding sphere fills the shorter side of the image, with a margin
 
 

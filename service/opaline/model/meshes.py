@@ -11,6 +11,8 @@ from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
 
 MESH_KIND = "file"
+# The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
+MESH_VIEW = (60.0, 20.0)
 
 
 def file_digest(path: Path) -> str:

@@ -33,6 +33,7 @@ from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
 from opaline.server.service import Service, SettingsDep, get_service
+from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import ImageTask
@@ -171,6 +172,7 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
     app.include_router(render_router)
     app.include_router(mesh_router)
+    app.include_router(turntable_router)
     app.include_router(router)
     mount_web(app)
     return app
