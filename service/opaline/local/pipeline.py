@@ -10,17 +10,15 @@ One LocalRenderer owns one GL context; use it from the thread that made it.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 
 from opaline.gl.renderer import Renderer
-from opaline.model.meshes import file_digest, mesh_preset
+from opaline.model.meshes import file_mesh_preset
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import encode_frame, encode_mdf
-from opaline.scene.meshfile import MeshError
 from opaline.settings import get_settings
 
 
@@ -62,11 +60,7 @@ class LocalRenderer:
         preset = get_preset(request.preset)
         if request.mesh is None:
             return preset
-        path = Path(request.mesh).expanduser()
-        if not path.is_file():
-            raise MeshError(f"mesh={request.mesh!r}: no such file")
-        preset = mesh_preset(preset, path.resolve(), file_digest(path), request,
-                             get_settings().mesh_max_triangles)
+        preset = file_mesh_preset(preset, request, get_settings().mesh_max_triangles)
         self.mesh_presets[preset.name] = preset
         return preset
 

@@ -39,3 +39,16 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
 
 def is_mesh(preset: Preset) -> bool:
     return preset.geometry.kind == MESH_KIND
+
+
+class MeshFileMissing(ValueError):
+    """A request names a mesh file that does not exist (CLI, Python API, material files)."""
+
+
+def file_mesh_preset(base: Preset, request: SceneFields, max_triangles: int) -> Preset:
+    """``base`` drawing the mesh file ``request.mesh`` (a path on this machine)."""
+    assert request.mesh is not None
+    path = Path(request.mesh).expanduser()
+    if not path.is_file():
+        raise MeshFileMissing(f"mesh={request.mesh!r}: no such file")
+    return mesh_preset(base, path.resolve(), file_digest(path), request, max_triangles)
