@@ -120,3 +120,17 @@ def test_environment_over_http(client):
     assert lit.status_code == 200 and lit.content.startswith(b"\x89PNG")
     unknown = client.get(f"/v1/render?preset=sphere&environment=../x.hdr&{SMALL}")
     assert unknown.status_code == 422 and "not known" in unknown.json()["detail"][0]
+
+
+@pytest.mark.gl
+def test_exports_over_http(client):
+    mesh_id = client.post("/v1/meshes", content=mesh_bytes("obj")).json()["id"]
+    glsl = client.get("/v1/export/glsl?preset=cd-rom&mu_f=6")
+    assert glsl.status_code == 200 and "opaline_radiance" in glsl.text
+    assert "const real u_mu_f = 6.0;" in glsl.text
+    glb = client.post("/v1/export/glb", json={"preset": "sphere", "mesh": mesh_id, "alpha": 3})
+    assert glb.status_code == 200 and glb.content[:4] == b"glTF"
+    from opaline.output.gltf import import_glb
+
+    assert import_glb(glb.content)["alpha"] == 3.0
+    assert client.post("/v1/export/glb", json={"mesh": "f" * 32}).status_code == 404

@@ -13,11 +13,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from opaline.gl.export_glsl import export_glsl
-from opaline.model.meshes import file_mesh_preset, is_mesh
+from opaline.model.meshes import file_mesh_preset
 from opaline.model.params import RenderRequest
-from opaline.model.presets import Preset, build_assets, get_preset
+from opaline.model.presets import build_assets, get_preset
 from opaline.model.request import resolve
-from opaline.output.gltf import export_glb, import_glb
+from opaline.output.gltf import export_glb, import_glb, tangent_fields
 from opaline.settings import get_settings
 
 ExportKind = Literal["glsl", "glb"]
@@ -35,17 +35,6 @@ def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind
         return export_glsl(job.material, job.wavelengths).encode()
     mesh, _ = build_assets(preset)
     return export_glb(mesh, job.material, job.wavelengths, preset.name, tangent_fields(preset))
-
-
-def tangent_fields(preset: Preset) -> dict[str, Any]:
-    """What makes the mesh's tangents again on import: the CD's concentric field, a file
-    mesh's own choice; UV-following tangents come back from the UVs by themselves."""
-    if is_mesh(preset):
-        args = preset.geometry.args
-        return {"tangent_field": args["tangent_field"], "tangent_axis": args["tangent_axis"]}
-    if preset.tangents == "concentric":  # about the object's y axis, as the shader's field
-        return {"tangent_field": "concentric", "tangent_axis": [0.0, 1.0, 0.0]}
-    return {}
 
 
 def import_material(path: Path | str, preset: str = "sphere") -> dict[str, Any]:

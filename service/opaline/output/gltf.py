@@ -19,7 +19,9 @@ import numpy as np
 import pygltflib as gl
 
 from opaline import __version__
+from opaline.model.meshes import is_mesh
 from opaline.model.params import MATERIAL_FIELDS, Material
+from opaline.model.presets import Preset
 from opaline.scene.mesh import Mesh
 
 EXTRAS_KEY = "opaline"
@@ -77,6 +79,18 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         accessors=accessors, bufferViews=views, buffers=[gl.Buffer(byteLength=len(blob))])
     document.set_binary_blob(blob)
     return b"".join(document.save_to_bytes())
+
+
+def tangent_fields(preset: Preset) -> dict[str, Any]:
+    """What makes the mesh's tangents again on import: the CD's concentric field, a file
+    mesh's own choice; UV-following tangents come back from the UVs by themselves."""
+    if is_mesh(preset):
+        args = preset.geometry.args
+        return {"tangent_field": args["tangent_field"], "tangent_axis": args["tangent_axis"]}
+    if preset.tangents == "concentric":  # about the object's y axis, as the shader's field
+        return {"tangent_field": "concentric", "tangent_axis": [0.0, 1.0, 0.0]}
+    return {}
+
 
 
 class GltfImportError(ValueError):

@@ -27,6 +27,7 @@ from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
 from opaline.server.cache import ImageCache
 from opaline.server.errors import Problem, install
+from opaline.server.export_routes import router as export_router
 from opaline.server.mesh_routes import router as mesh_router
 from opaline.server.meshstore import MeshStore
 from opaline.server.metrics import Metrics
@@ -173,6 +174,7 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.include_router(render_router)
     app.include_router(mesh_router)
     app.include_router(turntable_router)
+    app.include_router(export_router)
     app.include_router(router)
     mount_web(app)
     return app
