@@ -45,6 +45,7 @@ class OutputError(CliError):
 
 def parameter_help() -> str:
     lines = ["parameters for --set NAME=VALUE (unset ones come from the preset or file):"]
+    width = max(16, *map(len, RenderRequest.model_fields))
     for name, info in RenderRequest.model_fields.items():
         if name == "preset":
             continue
@@ -53,7 +54,7 @@ def parameter_help() -> str:
         # Descriptions state their range in words; add the bounds where one does not.
         if allowed and "…" not in desc:
             desc += f" Range {allowed}."
-        lines.append(f"  {name:<16} {desc}")
+        lines.append(f"  {name:<{width}} {desc}")
     return "\n".join(lines)
 
 
