@@ -4,10 +4,10 @@ orbit, and download the image, a turntable and the exports."""
 from __future__ import annotations
 
 import pytest
-from mesh_helpers import mesh_bytes
-from test_web import CHROMIUM, browser, open_page, page, server, settle, shown_bytes  # noqa: F401
 
+from mesh_helpers import mesh_bytes
 from opaline.output.animation import decode
+from test_web import CHROMIUM, browser, open_page, page, server, settle, shown_bytes  # noqa: F401
 
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason=f"{CHROMIUM} is missing")
 

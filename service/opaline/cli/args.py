@@ -45,7 +45,7 @@ class OutputError(CliError):
 
 def parameter_help() -> str:
     lines = ["parameters for --set NAME=VALUE (unset ones come from the preset or file):"]
-    width = max(16, *map(len, RenderRequest.model_fields))
+    width = max(16, *map(len, RenderRequest.model_fields)) + 1  # two spaces before the text
     for name, info in RenderRequest.model_fields.items():
         if name == "preset":
             continue

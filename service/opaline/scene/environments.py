@@ -11,7 +11,7 @@ nothing to ship and are the same on every machine:
   a sun 35° up, and a dim ground.
 
 Files (Radiance ``.hdr`` through OpenCV's reader, OpenEXR ``.exr`` through
-the OpenEXR package, both the optional ``environments`` extra) are read from
+the OpenEXR package) are read from
 the environments folder of the settings, in the worker processes; both
 libraries are imported only when a file is asked for.
 """
@@ -97,7 +97,7 @@ def read_file(path: Path) -> np.ndarray:
             image = np.asarray(image, dtype=np.float32)[..., 2::-1]
     except ImportError as exc:
         raise EnvironmentMapError(f"environment {path.name}: reading {suffix} files needs "
-                                  f"{exc.name}: pip install 'opaline[environments]'") from None
+                                  f"{exc.name}, a dependency of opaline: reinstall it") from None
     except (OSError, ValueError, KeyError, RuntimeError) as exc:
         raise EnvironmentMapError(f"environment {path.name}: cannot read: {exc}") from None
     if image.ndim != 3 or image.shape[2] < 3 or not np.all(np.isfinite(image[..., :3])):
