@@ -81,3 +81,19 @@ def test_hdr_files_from_the_environments_folder(tmp_path, suffix):
     (tmp_path / f"bad{suffix}").write_bytes(b"#?RADIANCE\nnot really")
     with pytest.raises(environments.EnvironmentMapError, match="cannot read"):
         environments.environment_lights(f"bad{suffix}", 8, folder=tmp_path)
+
+
+@pytest.mark.gl
+def test_background_shows_the_environment(local):
+    """With environment_background the pixels around the object are the map's radiance
+    (here: a view up into the sky is blue, brighter toward the horizon), else the preset's."""
+    common = dict(preset="sphere", environment="sky", width=48, height=48, samples=1,
+                  wavelengths=0, aa="none", camera_elevation=-30.0)
+    shown = local.render_array(RenderRequest(environment_background=True, **common))
+    plain = local.render_array(RenderRequest(**common))
+    assert shown[..., 3].min() == pytest.approx(1.0)  # every pixel covered
+    assert plain[0, 0, 3] == 0.0  # the corners are the preset's background
+    corner = shown[0, 0, :3]
+    assert corner[2] > corner[0] and corner[2] > 0.05  # sky blue above
+    sky = environments.sky()
+    assert corner[2] <= sky[..., 2].max()

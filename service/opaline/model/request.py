@@ -69,6 +69,7 @@ class Job:
     environment_rotation: float | None = None
     environment_intensity: float | None = None
     environment_lights: int | None = None
+    environment_background: bool | None = None
 
     @property
     def cost(self) -> int:

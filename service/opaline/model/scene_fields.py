@@ -56,3 +56,6 @@ class SceneFields(BaseModel):
         None, description="K: directional lights the environment becomes by median cut, "
                           "1 … 256 (default: the tier's: draft 8, standard 16, high 32, "
                           "reference 64).")
+    environment_background: bool | None = Field(
+        None, description="Show the environment behind the object instead of the preset's "
+                          "background (default false).")

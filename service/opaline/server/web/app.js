@@ -29,7 +29,7 @@
     ['scene', 'Mesh and camera', ['mesh', 'tangent_field', 'tangent_axis', 'camera_azimuth',
       'camera_elevation', 'camera_distance']],
     ['environment', 'Environment', ['environment', 'environment_rotation',
-      'environment_intensity', 'environment_lights']],
+      'environment_intensity', 'environment_lights', 'environment_background']],
     ['tier', 'Quality tier overrides', ['samples', 'wavelengths', 'aa']],
   ];
   const MATERIAL = new Set(GROUPS[0][2]);
