@@ -12,8 +12,10 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+import shutil
 import tempfile
 import threading
+import weakref
 from collections import OrderedDict
 from pathlib import Path
 
@@ -45,8 +47,9 @@ class MeshStore:
 
     def __init__(self, settings: Settings) -> None:
         root = settings.mesh_store_dir
-        if root is None:
+        if root is None:  # a private folder, removed with the store (or at exit)
             root = Path(tempfile.mkdtemp(prefix="opaline-meshes-"))
+            weakref.finalize(self, shutil.rmtree, root, True)
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.budget = settings.mesh_store_bytes
