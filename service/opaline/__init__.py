@@ -7,15 +7,20 @@ imported on first use so that importing the package stays light.
 from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "render", "render_array"]
+__all__ = ["__version__", "export_material", "render", "render_array", "render_turntable"]
 
 if TYPE_CHECKING:  # type checkers see the real signatures; at run time they load lazily
     from opaline.local.api import render, render_array
+    from opaline.local.export import export_material
+    from opaline.local.turntable import render_turntable
+
+LAZY = {"render": "api", "render_array": "api", "render_turntable": "turntable",
+        "export_material": "export"}
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("render", "render_array"):
-        from opaline.local import api as api_python
+    if name in LAZY:
+        from importlib import import_module
 
-        return getattr(api_python, name)
+        return getattr(import_module(f"opaline.local.{LAZY[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

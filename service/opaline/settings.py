@@ -101,6 +101,19 @@ class Settings(BaseSettings):
         64, ge=1, description="Open connections one client address may hold; beyond: refused.")
     presets_dir: Path | None = Field(
         None, description="Folder of scene presets (TOML) used instead of the built-in ones.")
+    mesh_max_bytes: int = Field(
+        64 * 1024 * 1024, ge=1024, description="Largest mesh file POST /v1/meshes accepts (413).")
+    mesh_max_triangles: int = Field(
+        2_000_000, ge=1, le=50_000_000, description="Most triangles a mesh may have (422).")
+    mesh_store_bytes: int = Field(
+        1024 * 1024 * 1024, ge=1024,
+        description="Bytes of uploaded meshes kept on disk; the least recently used go first.")
+    mesh_store_dir: Path | None = Field(
+        None, description="Where uploaded meshes are kept (default: a temporary folder).")
+    meshes_dir: Path | None = Field(
+        None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
+    environments_dir: Path | None = Field(
+        None, description="A folder of HDR environments (.hdr, .exr) requests may name.")
     warmup: bool = Field(
         True, description="Render a tiny image on each worker at start-up, so the first "
                           "request does not pay for shader compilation.")

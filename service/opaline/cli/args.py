@@ -24,7 +24,7 @@ from opaline.output.encode import EXTENSIONS
 from opaline.output.files import write_atomic
 from opaline.settings import BACKENDS
 
-TUPLE_FIELDS = {"albedo"}
+TUPLE_FIELDS = {"albedo", "tangent_axis"}
 MATERIAL_SUFFIXES = (".toml", ".json")
 # What an extension may hold: the first is what the extension alone means.
 FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",)}

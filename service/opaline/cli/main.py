@@ -18,18 +18,24 @@ import sys
 from pathlib import Path
 
 from opaline import __version__
-from opaline.cli import batch, gallery, merge, render, schema, serve
+from opaline.cli import batch, export, gallery, merge, render, schema, serve, turntable
 from opaline.cli.args import CliError
 from opaline.model.material_file import MaterialError
+from opaline.model.meshes import MeshFileMissing
 from opaline.model.params import RenderRequest
 from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
+from opaline.output.gltf import GltfImportError
 from opaline.resources import PRESETS_ENV, presets_dir
+from opaline.scene.environments import EnvironmentMapError
+from opaline.scene.meshfile import MeshError
 
 log = logging.getLogger("opaline.cli")
-USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError)
+USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
+                EnvironmentMapError, MeshFileMissing, GltfImportError)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
-USES_PRESETS = ("render", "presets", "batch", "gallery", "serve")
+USES_PRESETS = ("render", "presets", "batch", "gallery", "serve", "turntable", "export",
+                "import")
 
 
 def cmd_presets(args: argparse.Namespace) -> None:
@@ -98,7 +104,7 @@ def make_parser() -> argparse.ArgumentParser:
     render.add_common(info)
     info.set_defaults(func=cmd_info)
 
-    for module in (gallery, serve, batch, merge, schema):
+    for module in (gallery, serve, batch, merge, schema, turntable, export):
         module.register(sub)
     for name, command in sub.choices.items():
         add_global(command, presets=name in USES_PRESETS)

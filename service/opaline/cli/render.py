@@ -38,6 +38,8 @@ def cmd_render(args: argparse.Namespace) -> None:
         fields["quality"] = args.quality
     if args.transparent:
         fields["transparent"] = True
+    if args.mesh:
+        fields["mesh"] = args.mesh
     request = load_request(args.source, fields)
     fmt = output_format(args.output, wanted, request.format)
     request = request.model_copy(update={"format": fmt})
@@ -100,6 +102,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="quality tier (default standard)")
     render.add_argument("--transparent", action="store_true",
                         help="transparent PNG background")
+    render.add_argument("--mesh", metavar="FILE",
+                        help="draw this mesh (glTF/GLB, OBJ, PLY, STL) with the preset's lights "
+                             "and material; the camera frames it")
     add_output(render)
     add_common(render)
     render.set_defaults(func=cmd_render)

@@ -14,6 +14,7 @@ import moderngl
 import numpy as np
 
 from opaline.gl import physical
+from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset, build_assets, build_thickness
 
 TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
@@ -75,11 +76,20 @@ class Targets:
             obj.release()
 
 
+def bounding_sphere(positions: np.ndarray) -> tuple[np.ndarray, float]:
+    points = positions.astype(np.float64)
+    centre = (points.min(axis=0) + points.max(axis=0)) * 0.5
+    return centre, float(np.linalg.norm(points - centre, axis=1).max())
+
+
 class SceneGPU:
     """A preset's mesh and normal map, uploaded once."""
 
     def __init__(self, ctx: moderngl.Context, preset: Preset) -> None:
         mesh, normal_map = build_assets(preset)
+        # A user's mesh is framed by the camera: a sphere about its box's centre holding
+        # every vertex (tighter than the box's corners, so a torus fills the frame).
+        self.bounds = bounding_sphere(mesh.positions) if is_mesh(preset) else None
         self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
         self.normal_map = None

@@ -7,6 +7,7 @@ import math
 import numpy as np
 from pyrr import Matrix44
 
+from opaline.model.meshes import MESH_VIEW
 from opaline.model.presets import Camera, Light
 
 
@@ -72,3 +73,54 @@ def place_key_light(
     position = direction * radius + _centre(key, target)
     moved = key.model_copy(update={"position": tuple(float(x) for x in position)})
     return [moved, *lights[1:]]
+
+
+# Orbit and framing. Angles as the key light's: azimuth atan2(z, x), elevation above y = 0.
+FRAME_MARGIN = 1.08  # the bounding sphere fills the shorter side of the image, with a margin
+
+
+def orbit(target, azimuth_deg: float, elevation_deg: float, distance: float) -> tuple:
+    az, el = math.radians(azimuth_deg), math.radians(elevation_deg)
+    direction = np.array([math.cos(el) * math.cos(az), math.sin(el), math.cos(el) * math.sin(az)])
+    return tuple(float(x) for x in np.asarray(target, dtype=np.float64) + direction * distance)
+
+
+def framing_distance(radius: float, fov_deg: float, aspect: float) -> float:
+    """The distance at which a sphere of ``radius`` fits the narrower field of view."""
+    half_v = math.radians(fov_deg) / 2.0
+    half = min(half_v, math.atan(math.tan(half_v) * aspect))
+    return FRAME_MARGIN * radius / math.sin(half)
+
+
+def fit_matrix(sphere: tuple, target) -> np.ndarray:
+    """Row-vector model matrix that moves a mesh's bounding sphere (centre, radius) onto a
+    unit sphere at ``target``: a user's mesh then sits where the preset's lights and camera
+    expect an object, whatever units it was modelled in (mm, m, or a 1e4-wide scan)."""
+    centre, radius = np.asarray(sphere[0], dtype=np.float64), max(float(sphere[1]), 1e-30)
+    fit = np.eye(4)
+    fit[:3, :3] /= radius
+    fit[3, :3] = np.asarray(target, dtype=np.float64) - centre / radius
+    return fit
+
+
+def view_camera(camera: Camera, aspect: float, framed: bool = False,
+                azimuth_deg: float | None = None, elevation_deg: float | None = None,
+                distance: float | None = None) -> Camera:
+    """The camera a job sees through: ``framed`` (a user's mesh, fitted to a unit sphere at
+    the target by ``fit_matrix``) looks at that sphere from ``MESH_VIEW`` at the distance
+    that fits it in the image; then the orbit fields move it. ``distance`` is a multiple of
+    the framed or preset distance."""
+    target = np.asarray(camera.target, dtype=np.float64)
+    offset = np.asarray(camera.eye, dtype=np.float64) - target
+    radius = float(np.linalg.norm(offset)) or 1.0
+    az = math.degrees(math.atan2(offset[2], offset[0]))
+    el = math.degrees(math.asin(max(-1.0, min(1.0, offset[1] / radius))))
+    if framed:
+        radius = framing_distance(1.0, camera.fov_deg, aspect)
+        az, el = MESH_VIEW
+    elif azimuth_deg is None and elevation_deg is None and distance is None:
+        return camera
+    az = az if azimuth_deg is None else azimuth_deg
+    el = max(-89.0, min(89.0, el if elevation_deg is None else elevation_deg))
+    eye = orbit(target, az, el, radius * (distance or 1.0))
+    return camera.model_copy(update={"eye": eye, "up": (0.0, 1.0, 0.0)})

@@ -14,9 +14,16 @@ import moderngl
 import numpy as np
 
 from opaline.gl import physical, uniforms
+from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
-from opaline.gl.camera import model_matrix, place_key_light, view_projection
+from opaline.gl.camera import (
+    fit_matrix,
+    model_matrix,
+    view_camera,
+    view_projection,
+)
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.lighting import light_uniforms
 from opaline.gl.probes import Probes
 from opaline.gl.shaders import ProgramCache
 from opaline.lru import BudgetLRU
@@ -43,6 +50,7 @@ class Renderer(Probes):
         self._empty_vao: dict[int, moderngl.VertexArray] = {}
         self._flat_normal: moderngl.Texture | None = None
         self.programs = ProgramCache(self.ctx, budgets.max_programs, self._forget_program)
+        self.backgrounds = Backgrounds(self.ctx, self.fullscreen)
 
     # Resources
 
@@ -153,23 +161,27 @@ class Renderer(Probes):
             # AA stays as the job asks: it is a quality choice, not a scene feature.
             defines.update(DIFFUSE=True, FRESNEL=True, NORMAL_MAP=True)
             normal_map = normal_map or self.flat_normal_map()
-        program = self.programs.get("surface.glsl", defines)
         width, height = targets.size
-        lights = place_key_light(
-            preset.lights, preset.camera.target, job.light_azimuth, job.light_elevation
-        )
+        lights = light_uniforms(job, preset)
+        defines["LIGHT_COUNT"] = len(lights["u_light_position"])
+        program = self.programs.get("surface.glsl", defines)
         model = model_matrix(preset.rotation_deg)
+        if scene.bounds is not None:
+            model = fit_matrix(scene.bounds, preset.camera.target) @ model
+        camera = view_camera(preset.camera, width / height, scene.bounds is not None,
+                             job.camera_azimuth, job.camera_elevation, job.camera_distance)
+        view_proj = view_projection(camera, width / height)
+        background = self.backgrounds.prepare(self.programs, job, view_proj, targets.size)
+        normal_matrix = np.linalg.inv(model[:3, :3]).T
+        normal_matrix /= abs(np.linalg.det(normal_matrix)) ** (1.0 / 3.0)  # unit normals stay ~unit
         values = uniforms.material_uniforms(job.material, job.wavelengths)
         values.update(
             {
                 "u_model": model.astype("f4"),
-                "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
-                "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
-                "u_eye": tuple(preset.camera.eye),
-                "u_light_position": [
-                    (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights
-                ],
-                "u_light_irradiance": [tuple(light.irradiance) for light in lights],
+                "u_normal_matrix": normal_matrix.astype("f4"),
+                "u_view_proj": view_proj.astype("f4"),
+                "u_eye": tuple(camera.eye),
+                **lights,
                 "u_ambient": tuple(preset.ambient),
                 "u_aa_scale": 1.0 / np.sqrt(len(offsets)),
             }
@@ -197,9 +209,12 @@ class Renderer(Probes):
                 raise Cancelled(f"stopped after {index} of {len(offsets)} samples")
             targets.sample_fbo.use()
             targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            jitter = (2.0 * dx / width, 2.0 * dy / height)
+            if background is not None:
+                background(jitter)
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
-            program["u_jitter"].value = (2.0 * dx / width, 2.0 * dy / height)
+            program["u_jitter"].value = jitter
             vao.render(moderngl.TRIANGLES)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
@@ -223,12 +238,8 @@ class Renderer(Probes):
         source.use(location=0)
         uniforms.apply(
             program,
-            {
-                "u_accum": 0,
-                "u_inv_samples": 1.0 / count,
-                "u_exposure": job.exposure,
-                "u_background": tuple(preset.background),
-            },
+            {"u_accum": 0, "u_inv_samples": 1.0 / count, "u_exposure": job.exposure,
+             "u_background": tuple(preset.background)},
         )
         self.fullscreen(program)
 
@@ -239,6 +250,7 @@ class Renderer(Probes):
         self._empty_vao.clear()
         self._scenes.clear()
         self._targets.clear()
+        self.backgrounds.release()
         if self._flat_normal is not None:
             self._flat_normal.release()
         self.programs.release()

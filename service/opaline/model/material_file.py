@@ -106,6 +106,9 @@ def load_material(path: Path | str, overrides: dict[str, Any] | None = None) -> 
                             'preset = "cd-rom" (see `opaline schema`)', path)
     own = set(fields) - set(overrides or {})
     fields.update(overrides or {})
+    if isinstance(fields.get("mesh"), str) and "mesh" in own:
+        # A mesh written in the file is relative to the file, as an editor sees it.
+        fields["mesh"] = str(path.parent / Path(fields["mesh"]).expanduser())
     try:
         return RenderRequest.model_validate(fields)
     except ValidationError as exc:

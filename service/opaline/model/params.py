@@ -17,6 +17,7 @@ from opaline.model import messages
 # Re-exported: the CLI and the API read a field's range next to the models.
 from opaline.model.messages import field_range as field_range
 from opaline.model.physical_params import PhysicalFields, PhysicalMaterial
+from opaline.model.scene_fields import SceneFields
 
 TWO_PI = 2.0 * math.pi
 
@@ -101,7 +102,7 @@ class MaterialFields(PhysicalFields):
     )
 
 
-class RenderFields(MaterialFields):
+class RenderFields(MaterialFields, SceneFields):
     """What a request (or a preset's defaults) may set besides the material."""
 
     width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")

@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from opaline.model.params import STRICT, RenderFields, Unit, describe_errors
 from opaline.resources import presets_dir
-from opaline.scene import geometry, normalmaps, thickness
+from opaline.scene import geometry, meshfile, normalmaps, thickness
 
 Vec3 = tuple[float, float, float]
 NonNegative3 = tuple[
@@ -114,6 +114,9 @@ _assets: dict[str, tuple[Any, Any]] = {}
 
 def build_assets(preset: Preset) -> tuple[Any, Any]:
     """The preset's mesh and normal map (or None), generated once per scene."""
+    if preset.geometry.kind == "file":
+        # A user's mesh: loaded (and bounded in number) by meshfile, never kept here.
+        return meshfile.mesh_file(**preset.geometry.args), None
     key = preset.scene_key()
     if key not in _assets:
         mesh = geometry.build(preset.geometry.kind, **preset.geometry.args)

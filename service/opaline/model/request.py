@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 from opaline import __version__
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
 from opaline.model.presets import Preset, get_preset
+from opaline.model.scene_fields import MESH_FIELDS
 from opaline.resources import sources_digest
 
 # What each quality tier means; a request may override any field of it.
@@ -61,6 +62,14 @@ class Job:
     tonemap: str
     light_azimuth: float | None
     light_elevation: float | None
+    camera_azimuth: float | None = None
+    camera_elevation: float | None = None
+    camera_distance: float | None = None
+    environment: str | None = None
+    environment_rotation: float | None = None
+    environment_intensity: float | None = None
+    environment_lights: int | None = None
+    environment_background: bool | None = None
 
     @property
     def cost(self) -> int:
@@ -90,8 +99,8 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
     if preset is None:
         preset = get_preset(getattr(request, "preset", "sphere"))
     fields: dict = dict(BASE_DEFAULTS)
-    fields.update(preset.defaults.model_dump(exclude_none=True))
-    fields.update(request.model_dump(exclude_none=True, exclude={"preset"}))
+    fields.update(preset.defaults.model_dump(exclude_none=True, exclude=set(MESH_FIELDS)))
+    fields.update(request.model_dump(exclude_none=True, exclude={"preset", *MESH_FIELDS}))
     tier = TIERS[fields["quality"]]
     for name, value in tier.items():
         fields.setdefault(name, value)

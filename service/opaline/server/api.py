@@ -30,11 +30,15 @@ from opaline.server.cache import ImageCache
 from opaline.server.connections import STATS as CONNECTION_STATS
 from opaline.server.docs import SecurityHeaders, mount_docs
 from opaline.server.errors import ERROR_RESPONSES, Problem, install
+from opaline.server.export_routes import router as export_router
+from opaline.server.mesh_routes import router as mesh_router
+from opaline.server.meshstore import MeshStore
 from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness
 from opaline.server.service import Service, SettingsDep, get_service
+from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.factory import RendererFactory
 from opaline.workers.pool import WorkerPool
@@ -186,11 +190,15 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.dependency_overrides[get_settings] = lambda: settings
-    install(app, settings.max_body_bytes, metrics)
+    app.state.meshes = MeshStore(settings)
+    install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
     app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)
     app.add_middleware(Access, settings=settings, on_reject=metrics.reject)
     app.add_middleware(SecurityHeaders)
     app.include_router(render_router)
+    app.include_router(mesh_router)
+    app.include_router(turntable_router)
+    app.include_router(export_router)
     app.include_router(router)
     document(app, RenderRequest)
     mount_docs(app)

@@ -25,6 +25,7 @@ from pydantic import Field
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import Preset
 from opaline.model.request import Job, resolve
+from opaline.model.scene_fields import MESH_FIELDS
 from opaline.server.queries import MdfQuery, RenderQuery
 
 RENDER_PATH = "/v1/render"
@@ -33,8 +34,9 @@ MDF_PATH = "/v1/mdf"
 IMMUTABLE = "public, max-age=31536000, immutable"
 # Fixed order: the scene, then the tier (it sets the defaults of samples, wavelengths, aa),
 # then every other field as the request model declares it.
-ORDER = ("preset", "quality", *(n for n in RenderRequest.model_fields
-                                if n not in ("preset", "quality")))
+# The mesh fields follow the preset: they are part of the scene, and not of the Job.
+ORDER = ("preset", *MESH_FIELDS, "quality",
+         *(n for n in RenderRequest.model_fields if n not in ("preset", "quality", *MESH_FIELDS)))
 
 
 REV = Field(None, pattern="^[0-9a-f]{32}$",
@@ -69,28 +71,37 @@ def _field(job: Job, name: str) -> Any:
     return tuple(value) if isinstance(value, list) else value
 
 
-def canonical_fields(job: Job, preset: Preset) -> dict[str, Any]:
-    """The fewest fields, in ``ORDER``, that resolve to ``job`` on ``preset``."""
+def canonical_fields(job: Job, preset: Preset,
+                     request: RenderRequest | None = None) -> dict[str, Any]:
+    """The fewest fields, in ``ORDER``, that resolve to ``job`` on ``preset``. With a user's
+    mesh, ``preset`` is the mesh preset and ``request`` names the preset and the mesh."""
     fields: dict[str, Any] = {}
-    base = resolve(RenderRequest(preset=preset.name), preset)
-    if preset.name != RenderRequest.model_fields["preset"].default:
-        fields["preset"] = preset.name
+    name = request.preset if request is not None else preset.name
+    base = resolve(RenderRequest(preset=name), preset)
+    if name != RenderRequest.model_fields["preset"].default:
+        fields["preset"] = name
+    for field in MESH_FIELDS:
+        value = getattr(request, field, None)
+        if value is not None:
+            fields[field] = tuple(value) if isinstance(value, list) else value
     if job.quality != base.quality:
         fields["quality"] = job.quality
-        base = resolve(RenderRequest(preset=preset.name, quality=job.quality), preset)
-    for name in ORDER[2:]:
+        base = resolve(RenderRequest(preset=name, quality=job.quality), preset)
+    for name in ORDER[2 + len(MESH_FIELDS):]:
         value = _field(job, name)
         if value != _field(base, name):
             fields[name] = value
     return fields
 
 
-def canonical_job(job: Job, preset: Preset) -> tuple[Job, dict[str, str]]:
+def canonical_job(job: Job, preset: Preset,
+                  request: RenderRequest | None = None) -> tuple[Job, dict[str, str]]:
     """``job`` as its canonical query string reads back, and that query (without ``rev``).
 
     The key must come from the read-back job: spellings that differ only where the
     renderer cannot tell (-0.0 and 0.0) must share one key, one image and one URL."""
-    query = {name: spell(value) for name, value in canonical_fields(job, preset).items()}
+    fields = canonical_fields(job, preset, request)
+    query = {name: spell(value) for name, value in fields.items()}
     return resolve(CanonicalQuery.model_validate(query).request(), preset), query
 
 

@@ -25,11 +25,13 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.presets import UnknownPreset
 from opaline.model.request import CostError
+from opaline.server.meshstore import MeshTooLarge, UnknownMesh
 from opaline.server.metrics import REJECT_REASONS, Metrics
 from opaline.server.queries import Malformed, MdfQuery
 from opaline.workers.errors import (
     Cancelled,
     DeadlineExceeded,
+    InvalidInput,
     Overloaded,
     RenderFailed,
     TooSlow,
@@ -57,6 +59,9 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
     Unavailable: (503, "unavailable"),
     Cancelled: (503, "cancelled"),
     RenderFailed: (500, "render_failed"),
+    InvalidInput: (422, "invalid"),
+    UnknownMesh: (404, "unknown_mesh"),
+    MeshTooLarge: (413, "too_large"),
 }
 
 
@@ -162,22 +167,25 @@ async def on_crash(request: Request, exc: Exception) -> JSONResponse:
 class BodyLimit:
     """413 for a body over ``limit`` bytes: by its Content-Length, or counted as it arrives."""
 
-    def __init__(self, app: ASGIApp, limit: int, on_reject: Any) -> None:
+    def __init__(self, app: ASGIApp, limit: int, on_reject: Any,
+                 paths: dict[str, int] | None = None) -> None:
         self.app, self.limit, self.on_reject = app, limit, on_reject
+        self.paths = paths or {}  # routes whose body is a file, with their own limit
 
-    def _refuse(self, count: bool = True) -> str:
+    def _refuse(self, limit: int, count: bool = True) -> str:
         """Count the rejection (unless the error handler will); the message to answer it with."""
         if count:
             self.on_reject()
-        return f"request body over the {self.limit} byte limit"
+        return f"request body over the {limit} byte limit"
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        limit = self.paths.get(scope.get("path", ""), self.limit)
         declared = dict(scope["headers"]).get(b"content-length", b"")
-        if declared.isdigit() and int(declared) > self.limit:
-            await problem(413, "too_large", self._refuse())(scope, receive, send)
+        if declared.isdigit() and int(declared) > limit:
+            await problem(413, "too_large", self._refuse(limit))(scope, receive, send)
             return
         seen = 0
 
@@ -185,18 +193,19 @@ class BodyLimit:
             nonlocal seen
             message = await receive()
             seen += len(message.get("body", b""))
-            if seen > self.limit:
+            if seen > limit:
                 # The route's body reader re-raises it; on_http_error answers and counts it
-                raise HTTPException(413, self._refuse(count=False))
+                raise HTTPException(413, self._refuse(limit, count=False))
             return message
 
         await self.app(scope, counted, send)
 
 
-def install(app: FastAPI, max_body_bytes: int, metrics: Metrics) -> None:
+def install(app: FastAPI, max_body_bytes: int, metrics: Metrics,
+            file_limits: dict[str, int] | None = None) -> None:
     """The body limit and a handler for every public error, each counting its rejections."""
     app.add_middleware(BodyLimit, limit=max_body_bytes,
-                       on_reject=partial(metrics.reject, "too_large"))
+                       on_reject=partial(metrics.reject, "too_large"), paths=file_limits)
     app.add_exception_handler(RequestValidationError, on_invalid)
     app.add_exception_handler(HTTPException, on_http_error)
     app.add_exception_handler(ClientDisconnect, on_gone)

@@ -18,6 +18,7 @@ from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
+from opaline.scene.environments import EnvironmentMapError, check_name
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.canonical import (
     IMMUTABLE,
@@ -34,6 +35,7 @@ from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.service import Service, get_service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
+from opaline.workers.errors import InvalidInput
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -92,7 +94,15 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
     """Every answer names the image's canonical GET URL in Content-Location; only that URL
     is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade)."""
     preset = get_preset(params.preset)
-    job, query = canonical_job(resolve(params, preset), preset)
+    if params.mesh is not None:
+        preset = request.app.state.meshes.preset(params, preset,
+                                                 svc.settings.mesh_max_triangles)
+    if params.environment is not None:
+        try:
+            check_name(params.environment, svc.settings.environments_dir)
+        except EnvironmentMapError as exc:
+            raise InvalidInput(str(exc)) from None
+    job, query = canonical_job(resolve(params, preset), preset, params)
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
     url = canonical_url(query, key)

@@ -90,6 +90,8 @@ def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None
 def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
     from opaline.gl.renderer import Cancelled
     from opaline.gl.shaders import ShaderError
+    from opaline.scene.environments import EnvironmentMapError
+    from opaline.scene.meshfile import MeshError
 
     def should_stop() -> bool:
         return bool(cancel.value)
@@ -111,6 +113,8 @@ def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
             reply.kind, reply.error = "cancelled", str(exc)
         except ShaderError as exc:
             reply.kind, reply.error = "shader", str(exc)
+        except (MeshError, EnvironmentMapError) as exc:  # the user's file, not the worker
+            reply.kind, reply.error = "invalid", str(exc)
         except Exception:  # GL errors, lost contexts, anything the draw raised
             reply.kind, reply.error = "crash", traceback.format_exc()
             crashed = True

@@ -33,3 +33,11 @@ class RenderFailed(Exception):
     def __init__(self, incident: str) -> None:
         super().__init__(f"render failed (incident {incident})")
         self.incident = incident
+
+
+class InvalidInput(ValueError):
+    """The worker refused the job's input (a malformed or over-limit mesh file) (422)."""
+
+
+# The exception each non-failure reply kind of a worker becomes.
+REFUSED: dict[str, type[Exception]] = {"cancelled": Cancelled, "invalid": InvalidInput}

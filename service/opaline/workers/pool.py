@@ -3,8 +3,7 @@
 Admission (``admission``) refuses a job predicted to miss its deadline, alone
 (422) or behind the queue (503); the reaper drops queued jobs whose deadline
 passed; equal keys share one job; a job whose every waiter left is dropped
-from the queue, or stopped between samples; each ``Slot`` supervises one
-process (watchdog, replacement, recycling).
+from the queue, or stopped between samples; each ``Slot`` supervises one process.
 """
 
 from __future__ import annotations
@@ -23,6 +22,7 @@ from typing import Any
 from opaline.workers.admission import CostModel, admit
 from opaline.workers.child import Reply
 from opaline.workers.errors import (
+    REFUSED,
     Cancelled,
     DeadlineExceeded,
     RenderFailed,
@@ -192,8 +192,8 @@ class WorkerPool:
             if self.on_rendered is not None:
                 self.on_rendered(job.label, reply.seconds)
             self._settle(job, result=reply.data)
-        elif reply.kind == "cancelled":
-            self.fail(job, Cancelled(reply.error))
+        elif reply.kind in REFUSED:  # cancelled, or the client's input was bad: no incident
+            self.fail(job, REFUSED[reply.kind](reply.error))
         else:
             incident = uuid.uuid4().hex[:12]
             self.counters["render_failures"] += 1

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from opaline.gl.lighting import environment_count
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, all_presets
 from opaline.model.request import Job, resolve
@@ -46,7 +47,10 @@ class ImageTask:
 
     def units(self) -> tuple[str, float, int]:
         job = self.job
-        return self.preset.name, float(job.width * job.height * job.samples), job.wavelengths
+        units = float(job.width * job.height * job.samples)
+        if job.environment:  # calibrated on the preset's lights; the cost grows with K
+            units *= max(1.0, environment_count(job) / len(self.preset.lights))
+        return self.preset.name, units, job.wavelengths
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,10 @@
     ['light', 'Light', ['light_azimuth', 'light_elevation']],
     ['output', 'Output', ['width', 'height', 'quality', 'format', 'exposure', 'tonemap',
       'transparent']],
+    ['scene', 'Mesh and camera', ['mesh', 'tangent_field', 'tangent_axis', 'camera_azimuth',
+      'camera_elevation', 'camera_distance']],
+    ['environment', 'Environment', ['environment', 'environment_rotation',
+      'environment_intensity', 'environment_lights', 'environment_background']],
     ['tier', 'Quality tier overrides', ['samples', 'wavelengths', 'aa']],
   ];
   const MATERIAL = new Set([...GROUPS[0][2], ...GROUPS[1][2]]);
@@ -870,5 +874,8 @@
     }
   }
 
+  // For assets.js (mesh upload, downloads, turntables): the few things it needs.
+  window.opaline = { setValue, changedFields, renderQuery, valueOf,
+    preset: () => state.preset, problemLines };
   start();
 })();

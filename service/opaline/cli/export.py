@@ -1,0 +1,61 @@
+"""``opaline export`` (a material as GLSL or .glb) and ``opaline import`` (a .glb's material
+as a material file that renders it on the .glb's own mesh)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+from typing import Any
+
+from opaline.cli.args import CliError, add_common, load_request, parse_sets, write_output
+
+log = logging.getLogger("opaline.cli")
+KINDS = {".glsl": "glsl", ".frag": "glsl", ".glb": "glb"}
+
+
+def cmd_export(args: argparse.Namespace) -> None:
+    from opaline.local.export import export_material
+
+    fields: dict[str, Any] = parse_sets(args.set)
+    if args.mesh:
+        fields["mesh"] = args.mesh
+    request = load_request(args.source, fields)
+    kind = KINDS.get(Path(args.output).suffix.lower())
+    if kind is None:
+        raise CliError(f"-o {args.output}: the name must end in .glsl, .frag or .glb")
+    data = export_material(request, kind)  # type: ignore[arg-type]
+    write_output(args.output, data)
+    log.info("wrote %s (%d bytes)", args.output, len(data))
+
+
+def cmd_import(args: argparse.Namespace) -> None:
+    from opaline.local.export import import_material, material_file_text
+
+    fields = import_material(args.source, args.preset)
+    out = Path(args.output)
+    # The mesh path is written relative to the material file, as load_material reads it.
+    try:
+        fields["mesh"] = str(Path(fields["mesh"]).resolve().relative_to(out.resolve().parent))
+    except ValueError:
+        fields["mesh"] = str(Path(fields["mesh"]).resolve())
+    write_output(args.output, material_file_text(fields).encode())
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    export = sub.add_parser("export", help="a material as a GLSL function (.glsl) or as glTF "
+                                           "with its mesh (.glb)")
+    export.add_argument("source", metavar="PRESET|FILE", help="preset name or material file")
+    export.add_argument("--mesh", metavar="FILE", help="export this mesh instead of the preset's")
+    export.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a parameter; repeatable")
+    export.add_argument("-o", "--output", required=True, metavar="FILE",
+                        help="FILE.glsl (or .frag) or FILE.glb")
+    add_common(export)
+    export.set_defaults(func=cmd_export)
+    imp = sub.add_parser("import", help="a .glb exported by Opaline → a material file (JSON)")
+    imp.add_argument("source", metavar="FILE.glb")
+    imp.add_argument("--preset", default="sphere", help="preset for lights and background")
+    imp.add_argument("-o", "--output", required=True, metavar="FILE.json")
+    add_common(imp)
+    imp.set_defaults(func=cmd_import)

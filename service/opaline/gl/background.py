@@ -1,0 +1,74 @@
+"""The environment as the background (``environment_background``): its map drawn behind
+the object in every sample, before the surface pass, with the lights' rotation and scale.
+
+The maps are uploaded once per environment and kept (a few; they are 128×256 RGB
+float for the built-in ones), released with the renderer.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from collections.abc import Callable
+
+import moderngl
+import numpy as np
+
+from opaline.gl import uniforms
+from opaline.gl.shaders import ProgramCache
+from opaline.model.request import Job
+from opaline.scene.environments import resolve_map
+from opaline.settings import get_settings
+
+KEPT = 4
+ENVIRONMENT_UNIT = 2  # 0: the accumulate pass's source, 1: the normal map
+
+
+class Backgrounds:
+    def __init__(self, ctx: moderngl.Context, empty_vao: Callable[[moderngl.Program], None]):
+        self.ctx = ctx
+        self.fullscreen = empty_vao
+        self._maps: OrderedDict[str, moderngl.Texture] = OrderedDict()
+
+    def texture(self, name: str) -> moderngl.Texture:
+        found = self._maps.get(name)
+        if found is None:
+            radiance = resolve_map(name, get_settings().environments_dir)
+            height, width = radiance.shape[:2]
+            # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
+            data = np.ascontiguousarray(radiance[::-1], dtype="f4")
+            found = self.ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
+            found.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            found.repeat_x, found.repeat_y = True, False
+            self._maps[name] = found
+            while len(self._maps) > KEPT:
+                self._maps.popitem(last=False)[1].release()
+        self._maps.move_to_end(name)
+        return found
+
+    def prepare(self, programs: ProgramCache, job: Job, view_proj: np.ndarray,
+                size: tuple[int, int]) -> Callable[[tuple[float, float]], None] | None:
+        """A draw call for one sample (given its NDC jitter), or None when not asked for."""
+        if not (job.environment and job.environment_background):
+            return None
+        program = programs.get("environment.glsl")
+        texture = self.texture(job.environment)
+        intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
+        uniforms.apply(program, {
+            "u_environment": ENVIRONMENT_UNIT, "u_size": (float(size[0]), float(size[1])),
+            "u_inv_view_proj": np.linalg.inv(view_proj).astype("f4"),
+            "u_rotation": math.radians(job.environment_rotation or 0.0),
+            "u_intensity": intensity})
+
+        def draw(jitter: tuple[float, float]) -> None:
+            texture.use(location=ENVIRONMENT_UNIT)
+            program["u_jitter"].value = jitter
+            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+            self.fullscreen(program)
+
+        return draw
+
+    def release(self) -> None:
+        for texture in self._maps.values():
+            texture.release()
+        self._maps.clear()

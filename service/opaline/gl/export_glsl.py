@@ -1,0 +1,78 @@
+"""A tuned material as one self-contained GLSL function, for use outside Opaline.
+
+    vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v)
+
+returns the radiance reflected toward ``v`` per unit irradiance arriving from
+``l`` (all unit vectors, world space; ``t`` the tangent the anisotropy follows,
+orthogonalised against ``n`` inside), exactly the code Opaline's surface
+shader runs for this material's variant: the shader library with its
+``#include``s inlined, the variant's feature defines, and every material
+uniform turned into a constant. GLSL 3.30 core (no fp64), no textures, no
+uniforms: paste it into any fragment shader and multiply by your light.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+from opaline import __version__
+from opaline.gl import uniforms
+from opaline.gl.shaders import expand
+from opaline.model.params import Material
+
+UNIFORM = re.compile(r"^\s*uniform\s+(\w+)\s+(\w+)\s*(\[\s*(\w+)\s*\])?\s*;")
+GLSL_TYPES = {"real": "float", "real2": "vec2", "real3": "vec3"}
+ENTRY = """
+// The exported entry point.
+vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
+    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v));
+}
+"""
+
+
+def _literal(kind: str, value: object) -> str:
+    kind = GLSL_TYPES.get(kind, kind)
+    if kind == "float":
+        return repr(float(value))  # repr keeps every digit of the double
+    parts = ", ".join(repr(float(x)) for x in value)  # type: ignore[union-attr]
+    return f"{kind}({parts})"
+
+
+def _constant(match: re.Match[str], values: dict[str, object]) -> str:
+    kind, name, array = match.group(1), match.group(2), match.group(3)
+    if name not in values:
+        return f"// (unused by this variant) {match.group(0).strip()}"
+    value = values[name]
+    if array:
+        items = list(value)  # type: ignore[call-overload]
+        body = ", ".join(_literal(kind, v) for v in items)
+        glsl = GLSL_TYPES.get(kind, kind)
+        return f"const {kind} {name}[{len(items)}] = {glsl}[{len(items)}]({body});"
+    if isinstance(value, list):
+        value = value[0]
+    return f"const {kind} {name} = {_literal(kind, value)};"
+
+
+def export_glsl(material: Material, wavelengths: int = 0) -> str:
+    """The GLSL source of ``opaline_radiance`` for this material (aa none: no pixel footprint)."""
+    defines = uniforms.material_defines(material, wavelengths)
+    values = uniforms.material_uniforms(material, wavelengths)
+    values["u_aa_scale"] = 1.0
+    lines = [
+        f"// Opaline {__version__}: the multi-peak anisotropic microfacet model (Kang, Lee,",
+        "// Cho 2014) for one material, as Opaline renders it. Parameters:",
+        f"// {json.dumps(material.model_dump(mode='json'), sort_keys=True)}",
+        f"// wavelengths={wavelengths} (0: the paper's RGB rotations)",
+        "// Requires #version 330 core (or later) before this text.",
+    ]
+    for key in sorted(defines):
+        value = defines[key]
+        if value is not False:
+            lines.append(f"#define {key}" if value is True else f"#define {key} {int(value)}")
+    for line in expand("lib/reflectance.glsl", []):
+        if line.startswith("#line"):
+            continue
+        match = UNIFORM.match(line)
+        lines.append(_constant(match, values) if match else line)
+    return "\n".join(lines) + "\n" + ENTRY

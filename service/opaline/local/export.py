@@ -1,0 +1,48 @@
+"""Exports without HTTP: a request's material as GLSL or as a .glb with its mesh, and a
+.glb's material back as a material file. No GL context is needed for any of them.
+
+    from opaline.local.export import export_material
+    glsl = export_material({"preset": "cd-rom", "mu_f": 6}, "glsl")
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal
+
+from opaline.gl.export_glsl import export_glsl
+from opaline.model.meshes import file_mesh_preset
+from opaline.model.params import RenderRequest
+from opaline.model.presets import build_assets, get_preset
+from opaline.model.request import resolve
+from opaline.output.gltf import export_glb, import_glb, tangent_fields
+from opaline.settings import get_settings
+
+ExportKind = Literal["glsl", "glb"]
+
+
+def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind) -> bytes:
+    """GLSL source (UTF-8) or .glb bytes of the request's material (and, for .glb, mesh)."""
+    if not isinstance(request, RenderRequest):
+        request = RenderRequest.model_validate(dict(request))
+    preset = get_preset(request.preset)
+    if request.mesh is not None:
+        preset = file_mesh_preset(preset, request, get_settings().mesh_max_triangles)
+    job = resolve(request, preset)
+    if kind == "glsl":
+        return export_glsl(job.material, job.wavelengths).encode()
+    mesh, _ = build_assets(preset)
+    return export_glb(mesh, job.material, job.wavelengths, preset.name, tangent_fields(preset))
+
+
+def import_material(path: Path | str, preset: str = "sphere") -> dict[str, Any]:
+    """A material file's fields from a .glb: its material, drawn on its own mesh."""
+    path = Path(path)
+    fields = import_glb(path.read_bytes())
+    return {"preset": preset, "mesh": str(path), **fields}
+
+
+def material_file_text(fields: dict[str, Any]) -> str:
+    return json.dumps(fields, indent=2) + "\n"

@@ -1,0 +1,60 @@
+"""Turntables without HTTP: ``render_turntable`` in Python, ``opaline turntable`` on the CLI.
+
+    from opaline.local.turntable import render_turntable
+    webp = render_turntable({"preset": "cd-rom", "frames": 36, "animation": "webp"})
+
+Frames render one after another on the calling thread's renderer (as
+``opaline.render``), ``progress(done, total)`` is called after each, and the
+encoder (``opaline.output.animation``) makes the file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+
+from opaline.local.api import RequestError, renderer
+from opaline.local.pipeline import LocalRenderer
+from opaline.model.params import describe_errors
+from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
+from opaline.output.animation import encode
+from opaline.output.encode import quantise
+from opaline.settings import BackendName
+
+Progress = Callable[[int, int], None]
+
+
+def as_turntable(request: TurntableRequest | Mapping[str, Any]) -> TurntableRequest:
+    if isinstance(request, TurntableRequest):
+        return request
+    try:
+        return TurntableRequest.model_validate(dict(request))
+    except ValidationError as exc:
+        raise RequestError(describe_errors(exc, TurntableRequest)) from None
+
+
+def render_turntable(request: TurntableRequest | Mapping[str, Any], *,
+                     backend: BackendName | None = None,
+                     progress: Progress | None = None) -> bytes:
+    """The encoded animation (WebP, GIF or MP4 as ``animation`` says)."""
+    return turntable_bytes(renderer(backend), as_turntable(request), progress)
+
+
+def turntable_bytes(local: LocalRenderer, request: TurntableRequest,
+                    progress: Progress | None = None) -> bytes:
+    still = request.still()
+    preset = local.preset(still)
+    job = local.job(still)
+    check_turntable_cost(job, request.frames, local.budget)
+    frames: list[np.ndarray] = []
+    jobs = frame_jobs(job, preset, request.frames)
+    for index, frame_job in enumerate(jobs, 1):
+        frame = local.renderer.render(frame_job, preset)
+        assert frame.display is not None
+        frames.append(quantise(frame.display[..., :3], 8))
+        if progress is not None:
+            progress(index, len(jobs))
+    return encode(frames, request.animation, request.fps)

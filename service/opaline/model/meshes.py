@@ -1,0 +1,54 @@
+"""A request's mesh fields applied to a preset: the preset's lights, background and
+defaults drawing the user's mesh (geometry kind ``file``, loaded in the worker by
+``opaline.scene.meshfile``), the camera framed on its bounds by the renderer."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from opaline.model.presets import Generator, Preset
+from opaline.model.scene_fields import SceneFields
+
+MESH_KIND = "file"
+# The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
+MESH_VIEW = (60.0, 20.0)
+
+
+def file_digest(path: Path) -> str:
+    """Content hash of a mesh file (part of the scene key: an edited file draws anew)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for chunk in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()[:32]
+
+
+def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max_triangles: int) -> Preset:
+    """``base`` drawing the mesh at ``path``: its lights, background and
+    defaults, the camera framed on the mesh by the renderer, no normal map (the
+    mesh's UVs were not made for the preset's map)."""
+    args = {"kind": MESH_KIND, "path": str(path), "digest": digest,
+            "tangent_field": request.tangent_field or "auto",
+            "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
+            "max_triangles": max_triangles}
+    return base.model_copy(update={"name": f"mesh-{digest[:12]}",
+                                   "geometry": Generator(**args), "normal_map": None,
+                                   "tangents": "uv", "rotation_deg": (0.0, 0.0, 0.0)})
+
+
+def is_mesh(preset: Preset) -> bool:
+    return preset.geometry.kind == MESH_KIND
+
+
+class MeshFileMissing(ValueError):
+    """A request names a mesh file that does not exist (CLI, Python API, material files)."""
+
+
+def file_mesh_preset(base: Preset, request: SceneFields, max_triangles: int) -> Preset:
+    """``base`` drawing the mesh file ``request.mesh`` (a path on this machine)."""
+    assert request.mesh is not None
+    path = Path(request.mesh).expanduser()
+    if not path.is_file():
+        raise MeshFileMissing(f"mesh={request.mesh!r}: no such file")
+    return mesh_preset(base, path.resolve(), file_digest(path), request, max_triangles)

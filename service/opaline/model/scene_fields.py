@@ -1,0 +1,61 @@
+"""Request fields that change the scene rather than the material: the user's mesh, its
+tangent field, and the camera's orbit around the target.
+
+``RenderFields`` inherits them, so the CLI's ``--set``, material files, the
+Python API and both HTTP forms accept them with the same ranges. The mesh
+fields turn the preset into a mesh preset (``opaline.model.meshes``) and are not part
+of the ``Job``; the orbit fields are, because they change the image but not
+what is uploaded to the GPU (a turntable reuses one upload for every frame).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+TangentField = Literal["auto", "uv", "concentric", "projected"]
+Finite3 = tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
+                Annotated[float, Field(ge=-1e6, le=1e6)]]
+MESH_FIELDS = ("mesh", "tangent_field", "tangent_axis")
+ORBIT_FIELDS = ("camera_azimuth", "camera_elevation", "camera_distance")
+
+
+class SceneFields(BaseModel):
+    # As params.STRICT (params imports this module, so it cannot be imported from there).
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+    mesh: Annotated[str, Field(min_length=1, max_length=1024)] | None = Field(
+        None, description="The user's own mesh instead of the preset's: a file path (CLI, "
+                          "Python, material files; glTF/GLB, OBJ, PLY, STL) or, over HTTP, "
+                          "the id POST /v1/meshes answered (or a file of the meshes folder).")
+    tangent_field: TangentField | None = Field(
+        None, description="Tangents of a mesh: 'uv' (from its UVs), 'concentric' (circles about "
+                          "tangent_axis), 'projected' (tangent_axis projected on the surface); "
+                          "'auto' (default): 'uv' where the mesh has UVs, else 'concentric'.")
+    tangent_axis: Finite3 | None = Field(
+        None, description="Axis of the concentric field, or direction of the projected one "
+                          "(default 0,1,0).")
+    camera_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
+        None, description="Camera azimuth in degrees around the target's up axis "
+                          "(0: +x, 90: +z), -360 … 360 (default: the preset's view).")
+    camera_elevation: Annotated[float, Field(ge=-89.0, le=89.0)] | None = Field(
+        None, description="Camera elevation in degrees above the target's horizon, -89 … 89.")
+    camera_distance: Annotated[float, Field(ge=0.2, le=10.0)] | None = Field(
+        None, description="Camera distance as a multiple of the preset's (or, for a mesh, of "
+                          "the distance that frames its bounds), 0.2 … 10 (default 1).")
+
+    environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
+        None, description="Light the scene with an environment instead of the preset's lights: "
+                          "'studio', 'sky', or an .hdr/.exr file of the environments folder.")
+    environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
+        None, description="Turns the environment about the up axis, degrees (default 0).")
+    environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(
+        None, description="Multiplies the environment's radiance, 0 … 1000 (default 1).")
+    environment_lights: Annotated[int, Field(ge=1, le=256)] | None = Field(
+        None, description="K: directional lights the environment becomes by median cut, "
+                          "1 … 256 (default: the tier's: draft 8, standard 16, high 32, "
+                          "reference 64).")
+    environment_background: bool | None = Field(
+        None, description="Show the environment behind the object instead of the preset's "
+                          "background (default false).")

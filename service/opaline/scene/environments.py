@@ -1,0 +1,146 @@
+"""Environments that light a scene: procedural (a studio, a sky) and HDR image files.
+
+Each is an equirectangular map of linear radiance (``mediancut`` gives the
+convention), turned into directional lights by ``mediancut.median_cut``. The
+procedural ones are made here, in closed form, at a fixed size, so they cost
+nothing to ship and are the same on every machine:
+
+* ``studio``: a dim grey room with a large soft box above and in front, a
+  strip light to the side and a faint fill from behind, as product shots use;
+* ``sky``: a clear sky (brighter at the horizon, deeper blue at the zenith),
+  a sun 35° up, and a dim ground.
+
+Files (Radiance ``.hdr`` through OpenCV's reader, OpenEXR ``.exr`` through
+the OpenEXR package) are read from
+the environments folder of the settings, in the worker processes; both
+libraries are imported only when a file is asked for.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from pathlib import Path
+
+import numpy as np
+
+from opaline.scene.mediancut import directions, median_cut
+
+BUILTIN = ("studio", "sky")
+SIZE = (128, 256)  # rows, columns: 1.4° per texel, enough for soft boxes and the sun's disc
+SUFFIXES = (".hdr", ".exr")
+CACHED = 8
+
+
+class EnvironmentMapError(ValueError):
+    """An environment that is not known or cannot be read; the message says which."""
+
+
+def _box(d: np.ndarray, centre, half_width: float, half_height: float) -> np.ndarray:
+    """1 inside a rectangle of angular half-sizes (radians) facing ``centre``, soft edges."""
+    c = np.asarray(centre, dtype=np.float64)
+    c /= np.linalg.norm(c)
+    right = np.cross((0.0, 1.0, 0.0), c)
+    right = right / np.linalg.norm(right) if np.linalg.norm(right) > 1e-9 else np.array([1.0, 0, 0])
+    up = np.cross(c, right)
+    facing = d @ c
+    x = np.arctan2(d @ right, facing)
+    y = np.arctan2(d @ up, facing)
+    edge = np.maximum(np.abs(x) / half_width, np.abs(y) / half_height)
+    return np.clip((1.15 - edge) / 0.3, 0.0, 1.0) * (facing > 0)
+
+
+def studio() -> np.ndarray:
+    d, _ = directions(*SIZE)
+    up = d[..., 1:2]
+    room = np.where(up > 0, 0.03, 0.015) * np.ones(3)  # walls a little brighter than the floor
+    key = _box(d, (0.6, 0.9, 0.8), 0.45, 0.3)[..., None] * np.array([2.0, 1.95, 1.85])
+    strip = _box(d, (-1.0, 0.25, 0.2), 0.12, 0.55)[..., None] * np.array([1.1, 1.15, 1.25])
+    rim = _box(d, (0.2, 0.4, -1.0), 0.3, 0.2)[..., None] * np.array([0.5, 0.5, 0.5])
+    return (room + key + strip + rim).astype(np.float32)
+
+
+def sky() -> np.ndarray:
+    d, _ = directions(*SIZE)
+    e = np.clip(d[..., 1:2], 0.0, 1.0)
+    zenith, horizon = np.array([0.04, 0.09, 0.22]), np.array([0.22, 0.26, 0.32])
+    blue = horizon + (zenith - horizon) * np.sqrt(e)
+    ground = np.array([0.04, 0.035, 0.03])
+    radiance = np.where(d[..., 1:2] > 0, blue, ground)
+    sun_dir = np.array([np.cos(np.radians(35)) * np.cos(0.9), np.sin(np.radians(35)),
+                        np.cos(np.radians(35)) * np.sin(0.9)])
+    # A disc 2.5° across (wider than the real 0.53°, so 1.4° texels resolve it) carrying
+    # about three times the sky's irradiance, as on a clear day.
+    sun = (d @ sun_dir > np.cos(np.radians(1.25)))[..., None]
+    return (radiance + sun * np.array([1.0, 0.95, 0.88]) * 2400.0).astype(np.float32)
+
+
+def read_file(path: Path) -> np.ndarray:
+    """Linear RGB float32 (H, W, 3) from a Radiance .hdr or an OpenEXR file."""
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".exr":
+            import OpenEXR
+
+            with OpenEXR.File(str(path)) as exr:
+                channels = exr.channels()
+                if "RGB" in channels:
+                    image = np.asarray(channels["RGB"].pixels, dtype=np.float32)
+                else:
+                    image = np.stack([np.asarray(channels[c].pixels, dtype=np.float32)
+                                      for c in "RGB"], -1)
+        else:
+            import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
+
+            image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+            if image is None:
+                raise ValueError("not a Radiance .hdr image")
+            image = np.asarray(image, dtype=np.float32)[..., 2::-1]
+    except ImportError as exc:
+        raise EnvironmentMapError(f"environment {path.name}: reading {suffix} files needs "
+                                  f"{exc.name}, a dependency of opaline: reinstall it") from None
+    except (OSError, ValueError, KeyError, RuntimeError) as exc:
+        raise EnvironmentMapError(f"environment {path.name}: cannot read: {exc}") from None
+    if image.ndim != 3 or image.shape[2] < 3 or not np.all(np.isfinite(image[..., :3])):
+        raise EnvironmentMapError(f"environment {path.name}: expected finite RGB, got "
+                                f"shape {image.shape}")
+    return np.maximum(image[..., :3], 0.0)
+
+
+def check_name(name: str, folder: Path | None) -> Path | None:
+    """The file ``name`` means (None for a built-in one), without reading it: the HTTP
+    process checks names, workers read files."""
+    if name in BUILTIN:
+        return None
+    if folder is not None and Path(name).name == name and name.lower().endswith(SUFFIXES):
+        path = Path(folder) / name
+        if path.is_file():
+            return path
+    raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, sky, or an "
+                            ".hdr/.exr file of the environments folder")
+
+
+def resolve_map(name: str, folder: Path | None) -> np.ndarray:
+    path = check_name(name, folder)
+    if path is not None:
+        return read_file(path)
+    return studio() if name == "studio" else sky()
+
+
+_lights: OrderedDict[tuple, tuple[np.ndarray, np.ndarray]] = OrderedDict()
+
+
+def environment_lights(name: str, count: int, rotation_deg: float = 0.0, intensity: float = 1.0,
+                       folder: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(K, 3) directions toward the lights and (K, 3) irradiances, rotated about +y by
+    ``rotation_deg`` (the environment turns, the object stays) and scaled by ``intensity``."""
+    key = (name, count, str(folder))
+    if key not in _lights:
+        _lights[key] = median_cut(resolve_map(name, folder), count)
+        while len(_lights) > CACHED:
+            _lights.popitem(last=False)
+    _lights.move_to_end(key)
+    direction, irradiance = _lights[key]
+    a = np.radians(rotation_deg)
+    # Azimuth grows from +x toward +z (atan2(z, x)): rotate by +a in that sense.
+    rotate = np.array([[np.cos(a), 0.0, np.sin(a)], [0.0, 1.0, 0.0], [-np.sin(a), 0.0, np.cos(a)]])
+    return direction @ rotate, irradiance * intensity

@@ -1,0 +1,165 @@
+"""Meshes from files (glTF/GLB, OBJ, PLY, STL), read with trimesh and checked before use.
+
+Files come from users, so everything that can be wrong is a ``MeshError``
+with a message fit for an HTTP 4xx: not a mesh, truncated or malformed, no
+triangles, non-finite vertices, indices out of range, too many triangles.
+The format comes from the bytes (uploads have no name), the extension only
+breaking ties. Loading runs in the render worker processes only: trimesh's
+parsers are the riskiest code that ever sees a request, and a worker that
+crashes on one is replaced while the HTTP process answers on.
+
+The mesh keeps its own coordinates (the camera frames its bounds); normals
+are trimesh's area-weighted vertex normals; tangents are ``tangents.tangent_frame``.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections import OrderedDict
+from pathlib import Path
+
+import numpy as np
+
+from opaline.scene import tangents as tangent_fields
+from opaline.scene.mesh import Mesh, make_mesh
+
+FORMATS = ("glb", "gltf", "obj", "ply", "stl")
+DEFAULT_MAX_TRIANGLES = 2_000_000
+CACHED_MESHES = 4  # loaded meshes a worker keeps; the GPU copies have their own LRU
+OBJ_LINE = re.compile(rb"^[ \t]*(v|vt|vn|f|o|g|s|mtllib|usemtl)[ \t]", re.MULTILINE)
+
+
+class MeshError(ValueError):
+    """The file is not a mesh this service can draw; the message says why (HTTP 422)."""
+
+
+def sniff(data: bytes, suffix: str = "") -> str:
+    """The format of a mesh file from its first bytes; MeshError if it is none of them."""
+    if data[:4] == b"glTF":
+        return "glb"
+    head = data[:4096].lstrip()
+    if head.startswith(b"ply"):
+        return "ply"
+    if head.startswith(b"{"):
+        return "gltf"
+    # Binary STL: an 80-byte header, a triangle count and 50 bytes per triangle. Its
+    # header may start with "solid" too, so the size decides before the keyword does.
+    if len(data) >= 84 and 84 + 50 * int.from_bytes(data[80:84], "little") == len(data):
+        return "stl"
+    if head[:5].lower() == b"solid":
+        return "stl"
+    if suffix.lstrip(".").lower() == "obj" or OBJ_LINE.search(head):
+        return "obj"
+    raise MeshError("not a mesh: expected glTF/GLB, OBJ, PLY or STL "
+                    f"(the file starts with {data[:16]!r})")
+
+
+def _parse(data: bytes, fmt: str):
+    import trimesh  # imported here: only render workers ever parse a mesh
+
+    try:
+        loaded = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh", process=False)
+    except MeshError:
+        raise
+    except Exception as exc:  # each parser fails in its own way on bad bytes
+        raise MeshError(f"malformed or truncated {fmt.upper()} file: "
+                        f"{type(exc).__name__}: {exc}"[:400]) from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise MeshError(f"{fmt.upper()} file has no triangles")
+    if fmt == "stl" and np.all(np.isfinite(loaded.vertices)):
+        loaded.merge_vertices()  # STL repeats each corner per triangle: share them to smooth
+    return loaded
+
+
+def _uvs(loaded, count: int) -> np.ndarray | None:
+    uv = getattr(loaded.visual, "uv", None) if getattr(loaded.visual, "kind", None) else None
+    if uv is None:
+        return None
+    uv = np.asarray(uv, dtype=np.float64)
+    if uv.shape != (count, 2) or not np.all(np.isfinite(uv)):
+        return None
+    return uv
+
+
+def parse_mesh(data: bytes, suffix: str = "", field: str = "auto", axis=(0.0, 1.0, 0.0),
+               max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, dict]:
+    """A renderable ``Mesh`` and a summary (format, counts, bounds, tangent field used)."""
+    if not data:
+        raise MeshError("empty file: expected a glTF/GLB, OBJ, PLY or STL mesh")
+    fmt = sniff(data, suffix)
+    loaded = _parse(data, fmt)
+    faces = np.asarray(loaded.faces, dtype=np.int64)
+    positions = np.asarray(loaded.vertices, dtype=np.float64)
+    if len(faces) > max_triangles:
+        raise MeshError(f"{len(faces)} triangles is over this service's limit of {max_triangles}")
+    if faces.min() < 0 or faces.max() >= len(positions):
+        raise MeshError(f"triangle indices out of range (the file has {len(positions)} vertices)")
+    if not np.all(np.isfinite(positions)):
+        bad = int(np.count_nonzero(~np.all(np.isfinite(positions), axis=1)))
+        raise MeshError(f"{bad} vertices have NaN or infinite coordinates")
+    used = positions[np.unique(faces)]
+    if np.abs(used).max() > 1e15:
+        raise MeshError("vertex coordinates beyond ±1e15 cannot be drawn in float32")
+    areas = np.linalg.norm(np.cross(positions[faces[:, 1]] - positions[faces[:, 0]],
+                                    positions[faces[:, 2]] - positions[faces[:, 0]]), axis=1)
+    if not np.any(areas > 0.0):
+        raise MeshError("every triangle has zero area")
+    normals = _vertex_normals(positions, faces, areas)
+    uvs = _uvs(loaded, len(positions))
+    try:
+        tangents, used_field = tangent_fields.tangent_frame(positions, normals, uvs, faces,
+                                                            field, axis)
+    except ValueError as exc:
+        raise MeshError(str(exc)) from None
+    lo, hi = used.min(axis=0), used.max(axis=0)
+    mesh = make_mesh(positions, normals, tangents,
+                     uvs if uvs is not None else np.zeros((len(positions), 2)), faces)
+    summary = {"format": fmt, "triangles": len(faces), "vertices": len(positions),
+               "uvs": uvs is not None, "tangents": used_field,
+               "bounds": [lo.tolist(), hi.tolist()]}
+    return mesh, summary
+
+
+def _vertex_normals(positions: np.ndarray, faces: np.ndarray, areas: np.ndarray) -> np.ndarray:
+    """Area-weighted face normals summed per vertex (the cross product's length is 2×area)."""
+    face_n = np.cross(positions[faces[:, 1]] - positions[faces[:, 0]],
+                      positions[faces[:, 2]] - positions[faces[:, 0]])
+    summed = np.zeros_like(positions)
+    for corner in range(3):
+        np.add.at(summed, faces[:, corner], face_n)
+    length = np.linalg.norm(summed, axis=1)
+    bad = length < 1e-30  # unused vertices and cancelling fans: any unit vector will do
+    summed[bad] = (0.0, 1.0, 0.0)
+    length[bad] = 1.0
+    return summed / length[:, None]
+
+
+_loaded: OrderedDict[tuple, tuple[Mesh, dict]] = OrderedDict()
+
+
+def load_mesh_file(path: str | Path, field: str = "auto", axis=(0.0, 1.0, 0.0),
+                   max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, dict]:
+    """``parse_mesh`` of a file, the last few kept (keyed by path, size and mtime)."""
+    path = Path(path)
+    try:
+        stat = path.stat()
+        key = (str(path), stat.st_size, stat.st_mtime_ns, field, tuple(axis), max_triangles)
+        if key in _loaded:
+            _loaded.move_to_end(key)
+            return _loaded[key]
+        data = path.read_bytes()
+    except OSError as exc:
+        raise MeshError(f"cannot read mesh {path.name}: {exc.strerror or exc}") from None
+    found = parse_mesh(data, path.suffix, field, axis, max_triangles)
+    _loaded[key] = found
+    while len(_loaded) > CACHED_MESHES:
+        _loaded.popitem(last=False)
+    return found
+
+
+def mesh_file(path: str, digest: str = "", tangent_field: str = "auto",
+              tangent_axis=(0.0, 1.0, 0.0), max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
+    """The geometry generator ``file``: ``digest`` is unused here but names the content in
+    the preset's scene key, so a changed file never draws from a stale GPU copy."""
+    return load_mesh_file(path, tangent_field, tuple(tangent_axis), max_triangles)[0]

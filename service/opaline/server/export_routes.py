@@ -1,0 +1,50 @@
+"""Exports over HTTP: the material as GLSL (GET, computed here: no mesh, no GL) and the mesh
+with its material as .glb (POST, built by a worker, which alone touches meshes)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Depends, Query, Request
+from fastapi.responses import Response
+
+from opaline.gl.export_glsl import export_glsl
+from opaline.model.params import RenderRequest
+from opaline.model.presets import Preset, get_preset
+from opaline.model.request import Job, content_key, resolve
+from opaline.server.errors import ERROR_RESPONSES
+from opaline.server.queries import RenderQuery
+from opaline.server.service import Service, get_service
+from opaline.workers.export_task import GlbTask
+
+ServiceDep = Annotated[Service, Depends(get_service)]
+router = APIRouter()
+
+
+def _resolved(request: Request, svc: Service, params: RenderRequest) -> tuple[Preset, Job]:
+    preset = get_preset(params.preset)
+    if params.mesh is not None:
+        preset = request.app.state.meshes.preset(params, preset, svc.settings.mesh_max_triangles)
+    return preset, resolve(params, preset)
+
+
+@router.get("/v1/export/glsl", tags=["export"], response_class=Response,
+            responses=ERROR_RESPONSES,
+            summary="The material as one self-contained GLSL function (opaline_radiance)")
+async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Request,
+                          svc: ServiceDep) -> Response:
+    _, job = _resolved(request, svc, params)
+    return Response(export_glsl(job.material, job.wavelengths), media_type="text/plain",
+                    headers={"Content-Disposition": 'attachment; filename="opaline.glsl"'})
+
+
+@router.post("/v1/export/glb", tags=["export"], response_class=Response,
+             responses=ERROR_RESPONSES,
+             summary="The mesh with the material as glTF 2.0 binary (.glb)")
+async def export_glb_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
+    preset, job = _resolved(request, svc, body)
+    key = content_key({"glb": job.canonical(), "scene": preset.scene_key()})
+    data = await svc.pool.render(key, GlbTask(preset, job.material, job.wavelengths),
+                                 timeout=svc.wait_s)
+    return Response(data, media_type="model/gltf-binary",
+                    headers={"Content-Disposition": f'attachment; filename="{preset.name}.glb"'})

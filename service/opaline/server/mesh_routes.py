@@ -1,0 +1,70 @@
+"""POST /v1/meshes: a user's mesh file in, its id out, checked by a render worker.
+
+The HTTP process stores and hashes the bytes (``meshstore``); a worker parses
+and validates them (``workers.mesh_tasks``), so the answer is 201 with the
+mesh's summary, or 422 saying what is wrong with the file (which is then
+not kept), or 413 for a file over ``OPALINE_MESH_MAX_BYTES``. Renders name
+the id as ``mesh=<id>``; ``MeshStore.preset`` turns that into the preset the
+worker draws.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Depends, Request
+from pydantic import BaseModel, Field
+
+from opaline.server.errors import ERROR_RESPONSES, Problem
+from opaline.server.meshstore import MeshStore
+from opaline.server.render_routes import client_gone
+from opaline.server.service import Service, get_service
+from opaline.workers.errors import InvalidInput
+from opaline.workers.mesh_tasks import MeshCheckTask
+
+ServiceDep = Annotated[Service, Depends(get_service)]
+router = APIRouter()
+
+
+class MeshInfo(BaseModel):
+    id: str = Field(description="Name this mesh in render requests as mesh=<id>.")
+    format: str = Field(description="glb, gltf, obj, ply or stl, as read from the bytes.")
+    triangles: int
+    vertices: int
+    uvs: bool = Field(description="Whether the mesh has UV coordinates (tangents from them).")
+    tangents: str = Field(description="The tangent field an 'auto' request gets.")
+    bounds: list[list[float]] = Field(description="Lower and upper corner of its bounding box.")
+
+
+def store_of(request: Request) -> MeshStore:
+    return request.app.state.meshes
+
+
+MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
+    413: {"model": Problem, "description": "The file is over the service's size limit."},
+    **ERROR_RESPONSES,
+}
+
+
+@router.post("/v1/meshes", tags=["meshes"], status_code=201, responses=MESH_RESPONSES,
+             summary="Upload a mesh (glTF/GLB, OBJ, PLY or STL as the raw body)",
+             openapi_extra={"requestBody": {"required": True, "content": {
+                 "application/octet-stream": {"schema": {"type": "string",
+                                                         "format": "binary"}}}}})
+async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
+    data = await request.body()
+    if not data:
+        raise InvalidInput("empty body: send the mesh file (glTF/GLB, OBJ, PLY or STL) "
+                           "as the request body")
+    store = store_of(request)
+    mesh_id = store.put(data)
+    max_triangles = svc.settings.mesh_max_triangles
+    task = MeshCheckTask(str(store.path_of(mesh_id)), max_triangles)
+    try:
+        summary = await svc.pool.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
+                                        timeout=svc.wait_s, gone=client_gone(request))
+    except InvalidInput:
+        store.discard(mesh_id)
+        raise
+    return MeshInfo(id=mesh_id, **json.loads(summary))

@@ -1,0 +1,142 @@
+"""Uploaded meshes on disk, under their content hash, least recently used evicted first.
+
+The HTTP process only stores and hashes bytes here: it never parses a mesh
+(a render worker does, ``workers.mesh_tasks.MeshCheckTask``). A mesh is named
+by the first 32 hex digits of its SHA-256, so the same file uploaded twice is
+stored once and keeps its id; a request may also name a file of the folder
+``OPALINE_MESHES_DIR`` by its file name.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import tempfile
+import threading
+import weakref
+from collections import OrderedDict
+from pathlib import Path
+
+from opaline.model.meshes import file_digest, mesh_preset
+from opaline.model.presets import Preset
+from opaline.model.scene_fields import SceneFields
+from opaline.settings import Settings
+
+MESH_ID = re.compile(r"^[0-9a-f]{32}$")
+SUFFIX = ".mesh"  # the format is in the bytes; the worker sniffs it
+
+
+class UnknownMesh(KeyError):
+    def __init__(self, name: str) -> None:
+        self.name = name
+        super().__init__(name)
+
+    def __str__(self) -> str:
+        return (f"mesh={self.name!r} is not stored on this service (it may have been evicted): "
+                "upload it with POST /v1/meshes and use the id it answers")
+
+
+class MeshTooLarge(ValueError):
+    """The upload is over ``mesh_max_bytes`` (413)."""
+
+
+class MeshStore:
+    """Files ``<id>.mesh`` in one folder, their total bytes under a budget."""
+
+    def __init__(self, settings: Settings) -> None:
+        root = settings.mesh_store_dir
+        if root is None:  # a private folder, removed with the store (or at exit)
+            root = Path(tempfile.mkdtemp(prefix="opaline-meshes-"))
+            weakref.finalize(self, shutil.rmtree, root, True)
+        self.root = Path(root)
+        self.root.mkdir(parents=True, exist_ok=True)
+        self.budget = settings.mesh_store_bytes
+        self.max_file = settings.mesh_max_bytes
+        self.folder = settings.meshes_dir
+        self._lock = threading.Lock()
+        self._sizes: OrderedDict[str, int] = OrderedDict()
+        self._folder_digests: dict[tuple[str, int, int], str] = {}
+        self.evictions = 0
+        # What an earlier run left, oldest first, so restarts keep the LRU order.
+        found = sorted(self.root.glob("*" + SUFFIX), key=lambda p: p.stat().st_mtime_ns)
+        for path in found:
+            if MESH_ID.match(path.stem):
+                self._sizes[path.stem] = path.stat().st_size
+        self._evict()
+
+    @property
+    def size_bytes(self) -> int:
+        return sum(self._sizes.values())
+
+    def path_of(self, mesh_id: str) -> Path:
+        return self.root / f"{mesh_id}{SUFFIX}"
+
+    def put(self, data: bytes) -> str:
+        """Store ``data`` (atomically) and answer its id; the newest is never evicted."""
+        if len(data) > self.max_file:
+            raise MeshTooLarge(f"mesh file of {len(data)} bytes is over this service's limit "
+                               f"of {self.max_file} bytes")
+        mesh_id = hashlib.sha256(data).hexdigest()[:32]
+        with self._lock:
+            path = self.path_of(mesh_id)
+            if mesh_id not in self._sizes:
+                fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".part")
+                with os.fdopen(fd, "wb") as stream:
+                    stream.write(data)
+                os.replace(tmp, path)
+                self._sizes[mesh_id] = len(data)
+            self._touch(mesh_id)
+            self._evict(keep=mesh_id)
+        return mesh_id
+
+    def discard(self, mesh_id: str) -> None:
+        """Forget a mesh the worker refused, so an invalid file never takes space."""
+        with self._lock:
+            if self._sizes.pop(mesh_id, None) is not None:
+                self.path_of(mesh_id).unlink(missing_ok=True)
+
+    def resolve(self, name: str) -> tuple[Path, str]:
+        """The file and content digest a request's ``mesh`` names; UnknownMesh if none."""
+        if MESH_ID.match(name):
+            with self._lock:
+                if name in self._sizes and self.path_of(name).is_file():
+                    self._touch(name)
+                    return self.path_of(name), name
+        elif self.folder is not None and "/" not in name and "\\" not in name \
+                and not name.startswith("."):
+            path = Path(self.folder) / name
+            if path.is_file():
+                return path, self._folder_digest(path)
+        raise UnknownMesh(name)
+
+    def _folder_digest(self, path: Path) -> str:
+        stat = path.stat()
+        key = (str(path), stat.st_size, stat.st_mtime_ns)
+        if key not in self._folder_digests:
+            self._folder_digests[key] = file_digest(path)
+        return self._folder_digests[key]
+
+    def _touch(self, mesh_id: str) -> None:
+        self._sizes.move_to_end(mesh_id)
+        try:
+            os.utime(self.path_of(mesh_id))  # the order survives a restart
+        except OSError:
+            pass
+
+    def _evict(self, keep: str | None = None) -> None:
+        while self.size_bytes > self.budget and len(self._sizes) > (1 if keep else 0):
+            oldest = next(iter(self._sizes))
+            if oldest == keep:
+                self._sizes.move_to_end(oldest)
+                continue
+            del self._sizes[oldest]
+            self.path_of(oldest).unlink(missing_ok=True)
+            self.evictions += 1
+
+    def preset(self, params: SceneFields, base: Preset, max_triangles: int) -> Preset:
+        """``base`` drawing the mesh ``params.mesh`` names (UnknownMesh, 404, if none)."""
+        assert params.mesh is not None
+        path, digest = self.resolve(params.mesh)
+        return mesh_preset(base, path, digest, params, max_triangles)

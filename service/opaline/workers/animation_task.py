@@ -1,0 +1,33 @@
+"""Encode a turntable's frames in a worker: the HTTP process never runs an encoder.
+
+The frames arrive as the PNGs the frame renders answered (and the image
+cache holds), so a repeated turntable costs one encode and no render."""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from PIL import Image
+
+from opaline.output.animation import encode
+from opaline.workers.tasks import StopCheck
+
+ENCODE_LABEL = "animation"
+
+
+@dataclass(frozen=True)
+class AnimationTask:
+    frames: tuple[bytes, ...]
+    fmt: str
+    fps: int
+    label: str = ENCODE_LABEL
+
+    def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
+        frames = [np.asarray(Image.open(io.BytesIO(png)).convert("RGB")) for png in self.frames]
+        return encode(frames, self.fmt, self.fps)
+
+    def units(self) -> tuple[str, float, int]:
+        return ENCODE_LABEL, 0.0, 0

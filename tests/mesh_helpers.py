@@ -1,0 +1,64 @@
+"""Mesh files of every format, generated in the test (never downloaded), and broken ones."""
+
+from __future__ import annotations
+
+import io
+import struct
+
+import numpy as np
+import trimesh
+import trimesh.visual
+
+FORMATS = ("glb", "gltf", "obj", "ply", "stl")
+
+
+def torus_with_uvs() -> trimesh.Trimesh:
+    """An off-centre, scaled torus (so framing has work to do) with UVs on its vertices."""
+    mesh = trimesh.creation.torus(1.0, 0.35, major_sections=48, minor_sections=24)
+    angle = np.arctan2(mesh.vertices[:, 1], mesh.vertices[:, 0])
+    uv = np.stack([(angle / (2 * np.pi)) % 1.0, (mesh.vertices[:, 2] + 0.35) / 0.7], 1)
+    mesh.visual = trimesh.visual.TextureVisuals(uv=uv)
+    mesh.apply_transform(trimesh.transformations.rotation_matrix(0.6, (1, 0, 0)))
+    mesh.apply_scale(40.0)
+    mesh.apply_translation((300.0, -120.0, 55.0))
+    return mesh
+
+
+def mesh_bytes(fmt: str, mesh: trimesh.Trimesh | None = None) -> bytes:
+    mesh = mesh if mesh is not None else torus_with_uvs()
+    if fmt == "gltf":  # one JSON file with its buffer embedded as a data URI
+        data = mesh.export(file_type="gltf", embed_buffers=True)
+        return data["model.gltf"]
+    data = mesh.export(file_type=fmt)
+    return data.encode() if isinstance(data, str) else data
+
+
+def binary_stl(vertices: np.ndarray) -> bytes:
+    """A binary STL of triangles given as (M, 3, 3) corners (written by hand, NaN allowed)."""
+    rows = [struct.pack("<12fH", 0, 0, 0, *tri.ravel(), 0) for tri in vertices]
+    return b"\0" * 80 + struct.pack("<I", len(rows)) + b"".join(rows)
+
+
+def broken_files() -> dict[str, bytes]:
+    """Each refused with a 4xx and a message: name → bytes."""
+    good_glb = mesh_bytes("glb")
+    good_ply = mesh_bytes("ply")
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], dtype=float)
+    nan = tri.copy()
+    nan[0, 1, 0] = np.nan
+    return {
+        "not-a-mesh": b"\x89PNG\r\n\x1a\n" + bytes(200),
+        "malformed-glb": b"glTF" + bytes(40),
+        "truncated-glb": good_glb[: len(good_glb) // 2],
+        "truncated-ply": good_ply[: len(good_ply) // 3],
+        "malformed-obj": b"v 0 0 0\nv 1 0 0\nf 1 2 7\n",
+        "zero-triangles-obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\n",
+        "zero-triangles-stl": binary_stl(np.zeros((0, 3, 3))),
+        "nan-vertex-stl": binary_stl(nan),
+        "nan-vertex-obj": b"v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n",
+        "zero-area-obj": b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    }
+
+
+def load(data: bytes, fmt: str) -> trimesh.Trimesh:
+    return trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh")

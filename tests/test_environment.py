@@ -1,0 +1,99 @@
+"""Environment lighting: median cut keeps the map's energy at every K, the environment turns
+with its rotation, and a render converges as K rises (error falls monotonically)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from opaline.model.params import RenderRequest
+from opaline.scene import environments
+from opaline.scene.mediancut import directions, median_cut
+
+COUNTS = (1, 4, 16, 64)
+REFERENCE = 256
+
+
+@pytest.mark.parametrize("name", environments.BUILTIN)
+def test_median_cut_keeps_the_total_and_finds_the_bright_part(name):
+    radiance = environments.resolve_map(name, None)
+    d, solid = directions(*radiance.shape[:2])
+    total = (radiance * solid[..., None]).sum((0, 1))
+    for count in (1, 7, 32):
+        toward, irradiance = median_cut(radiance, count)
+        assert len(toward) == count
+        np.testing.assert_allclose(np.linalg.norm(toward, axis=1), 1.0)
+        np.testing.assert_allclose(irradiance.sum(0), total, rtol=1e-9)
+    # One light sits at the energy's centroid: for the sky, near the sun (35° up).
+    toward, _ = median_cut(radiance, 1)
+    if name == "sky":
+        assert np.degrees(np.arcsin(toward[0, 1])) == pytest.approx(35.0, abs=6.0)
+    solid_total = solid.sum() * radiance.shape[1]
+    assert solid_total == pytest.approx(4 * np.pi, rel=1e-3)
+
+
+def test_rotation_turns_the_lights_about_up():
+    base, e0 = environments.environment_lights("sky", 4)
+    turned, e1 = environments.environment_lights("sky", 4, rotation_deg=90.0, intensity=2.0)
+    azimuth = np.degrees(np.arctan2(base[:, 2], base[:, 0]))
+    turned_azimuth = np.degrees(np.arctan2(turned[:, 2], turned[:, 0]))
+    np.testing.assert_allclose((turned_azimuth - azimuth) % 360.0, 90.0, atol=1e-6)
+    np.testing.assert_allclose(turned[:, 1], base[:, 1])
+    np.testing.assert_allclose(e1, 2.0 * e0)
+
+
+def test_unknown_environment_is_refused():
+    with pytest.raises(ValueError, match="not known"):
+        environments.environment_lights("../etc/passwd", 4)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", environments.BUILTIN)
+def test_render_converges_as_k_rises(local, name):
+    """RMS error against K=256 falls monotonically with K, and K=64 is close."""
+    def render(count: int) -> np.ndarray:
+        request = RenderRequest(preset="sphere", environment=name, environment_lights=count,
+                                width=64, height=64, samples=1, wavelengths=0, aa="none")
+        return local.render_array(request)[..., :3].astype(np.float64)
+
+    reference = render(REFERENCE)
+    errors = [float(np.sqrt(np.mean((render(k) - reference) ** 2))) for k in COUNTS]
+    assert all(a > b for a, b in zip(errors, errors[1:], strict=False)), errors
+    assert errors[-1] < 0.25 * errors[0], errors
+
+
+@pytest.mark.parametrize("suffix", [".hdr", ".exr"])
+def test_hdr_files_from_the_environments_folder(tmp_path, suffix):
+    """A Radiance .hdr (OpenCV) and an OpenEXR file (OpenEXR) of the sky light like the sky."""
+    sky = environments.sky()
+    path = tmp_path / f"sky{suffix}"
+    if suffix == ".hdr":
+        cv2 = pytest.importorskip("cv2")
+        cv2.imwrite(str(path), np.ascontiguousarray(sky[..., ::-1]))
+    else:
+        exr = pytest.importorskip("OpenEXR")
+        header = {"compression": exr.ZIP_COMPRESSION, "type": exr.scanlineimage}
+        with exr.File(header, {"RGB": sky}) as file:
+            file.write(str(path))
+    _, from_file = environments.environment_lights(path.name, 8, folder=tmp_path)
+    _, builtin = environments.environment_lights("sky", 8)
+    np.testing.assert_allclose(from_file.sum(0), builtin.sum(0), rtol=0.01)  # RGBE: 1% steps
+    (tmp_path / f"bad{suffix}").write_bytes(b"#?RADIANCE\nnot really")
+    with pytest.raises(environments.EnvironmentMapError, match="cannot read"):
+        environments.environment_lights(f"bad{suffix}", 8, folder=tmp_path)
+
+
+@pytest.mark.gl
+def test_background_shows_the_environment(local):
+    """With environment_background the pixels around the object are the map's radiance
+    (here: a view up into the sky is blue, brighter toward the horizon), else the preset's."""
+    common = dict(preset="sphere", environment="sky", width=48, height=48, samples=1,
+                  wavelengths=0, aa="none", camera_elevation=-30.0)
+    shown = local.render_array(RenderRequest(environment_background=True, **common))
+    plain = local.render_array(RenderRequest(**common))
+    assert shown[..., 3].min() == pytest.approx(1.0)  # every pixel covered
+    assert plain[0, 0, 3] == 0.0  # the corners are the preset's background
+    corner = shown[0, 0, :3]
+    assert corner[2] > corner[0] and corner[2] > 0.05  # sky blue above
+    sky = environments.sky()
+    assert corner[2] <= sky[..., 2].max()

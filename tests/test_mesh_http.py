@@ -1,0 +1,136 @@
+"""Meshes over HTTP: POST /v1/meshes stores by content hash (parsed only in a worker),
+render requests name mesh=<id>, broken and over-limit files get 4xx, the service stays ready."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+from PIL import Image
+
+from mesh_helpers import FORMATS, broken_files, mesh_bytes
+from opaline.server.api import create_app
+from opaline.server.meshstore import MeshStore, MeshTooLarge, UnknownMesh
+from opaline.settings import Settings
+from test_meshes import assert_framed
+
+SMALL = "width=96&height=80&quality=draft&transparent=true"
+
+
+@pytest.fixture(scope="module")
+def client(backend, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("meshes")
+    (folder / "shelf.ply").write_bytes(mesh_bytes("ply"))
+    settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
+                        mesh_max_bytes=400_000, mesh_max_triangles=5000, meshes_dir=folder,
+                        mesh_store_dir=tmp_path_factory.mktemp("store"))
+    with TestClient(create_app(settings)) as client:
+        yield client
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_upload_then_render_each_format(client, fmt):
+    data = mesh_bytes(fmt)
+    answer = client.post("/v1/meshes", content=data)
+    assert answer.status_code == 201, answer.text
+    info = answer.json()
+    assert info["format"] == fmt and info["triangles"] == 2304 and len(info["id"]) == 32
+    assert client.post("/v1/meshes", content=data).json()["id"] == info["id"]  # content hash
+    image = client.get(f"/v1/render?preset=sphere&mesh={info['id']}&{SMALL}")
+    assert image.status_code == 200, image.text
+    rgba = np.asarray(Image.open(io.BytesIO(image.content)))
+    assert rgba.shape == (80, 96, 4)
+    assert_framed(rgba[..., 3] / 255.0)
+    posted = client.post("/v1/render", json={"preset": "nacre", "mesh": info["id"],
+                                             "camera_azimuth": 200, "width": 64, "height": 64})
+    assert posted.status_code == 200 and posted.content.startswith(b"\x89PNG")
+
+
+@pytest.mark.gl
+def test_folder_meshes_by_name(client):
+    assert client.get(f"/v1/render?mesh=shelf.ply&{SMALL}").status_code == 200
+    for name in ("../shelf.ply", "missing.ply", "0" * 32):
+        answer = client.get(f"/v1/render?mesh={name}&{SMALL}")
+        assert answer.status_code == 404 and "POST /v1/meshes" in answer.json()["detail"]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("name", sorted(broken_files()))
+def test_broken_uploads_get_422_and_the_service_stays_ready(client, name):
+    answer = client.post("/v1/meshes", content=broken_files()[name])
+    assert answer.status_code == 422, answer.text
+    assert len(answer.json()["detail"][0]) > 10
+    assert client.get("/readyz").status_code == 200
+
+
+@pytest.mark.gl
+def test_over_limit_uploads(client):
+    big = client.post("/v1/meshes", content=b"solid x\n" + b" " * 500_000)
+    assert big.status_code == 413 and "400000" in big.json()["detail"]
+    many = client.post("/v1/meshes", content=_many_triangles())
+    assert many.status_code == 422 and "limit of 5000" in many.json()["detail"][0]
+    empty = client.post("/v1/meshes", content=b"")
+    assert empty.status_code == 422
+    assert client.get("/readyz").status_code == 200
+    assert client.get(f"/v1/render?preset=sphere&{SMALL}").status_code == 200
+
+
+def _many_triangles() -> bytes:
+    import trimesh
+
+    return trimesh.creation.icosphere(4).export(file_type="ply")  # 5120 triangles
+
+
+def test_store_evicts_least_recently_used(tmp_path):
+    settings = Settings(mesh_store_dir=tmp_path, mesh_store_bytes=2500, mesh_max_bytes=2000)
+    store = MeshStore(settings)
+    first, second = store.put(b"a" * 1000), store.put(b"b" * 1000)
+    store.resolve(first)  # used: now the second is the oldest
+    third = store.put(b"c" * 1000)
+    assert store.evictions == 1 and store.size_bytes == 2000
+    assert store.resolve(first)[0].read_bytes() == b"a" * 1000
+    assert store.resolve(third)[1] == third
+    with pytest.raises(UnknownMesh):
+        store.resolve(second)
+    with pytest.raises(MeshTooLarge):
+        store.put(b"d" * 2001)
+    reopened = MeshStore(settings)  # what is on disk survives a restart, in order
+    assert sorted(reopened._sizes) == sorted([first, third])
+
+
+def test_http_process_never_imports_a_mesh_parser():
+    """The app and its routes load without trimesh: parsing is the workers' job."""
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['trimesh'] = None\n"
+            "from opaline.server.api import create_app\n"
+            "from opaline.settings import Settings\n"
+            "create_app(Settings(warmup=False, calibrate=False))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.gl
+def test_environment_over_http(client):
+    lit = client.get(f"/v1/render?preset=sphere&environment=sky&environment_lights=8&{SMALL}")
+    assert lit.status_code == 200 and lit.content.startswith(b"\x89PNG")
+    unknown = client.get(f"/v1/render?preset=sphere&environment=../x.hdr&{SMALL}")
+    assert unknown.status_code == 422 and "not known" in unknown.json()["detail"][0]
+
+
+@pytest.mark.gl
+def test_exports_over_http(client):
+    mesh_id = client.post("/v1/meshes", content=mesh_bytes("obj")).json()["id"]
+    glsl = client.get("/v1/export/glsl?preset=cd-rom&mu_f=6")
+    assert glsl.status_code == 200 and "opaline_radiance" in glsl.text
+    assert "const real u_mu_f = 6.0;" in glsl.text
+    glb = client.post("/v1/export/glb", json={"preset": "sphere", "mesh": mesh_id, "alpha": 3})
+    assert glb.status_code == 200 and glb.content[:4] == b"glTF"
+    from opaline.output.gltf import import_glb
+
+    assert import_glb(glb.content)["alpha"] == 3.0
+    assert client.post("/v1/export/glb", json={"mesh": "f" * 32}).status_code == 404
