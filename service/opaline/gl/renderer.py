@@ -22,6 +22,7 @@ from opaline.model.params import Material
 from opaline.model.presets import Preset, build_assets, get_preset
 from opaline.model.request import Job
 from opaline.model.sampling import sample_offsets
+from opaline.model.spectrum import wavelength_shift
 
 log = logging.getLogger(__name__)
 MAX_TARGET_SIZES = 4
@@ -221,7 +222,12 @@ class Renderer:
             accumulate["u_sample"].value = 0
             targets.accum_fbo.use()
             targets.accum_fbo.clear(0.0, 0.0, 0.0, 0.0)
-        for dx, dy in offsets:
+        for index, (dx, dy) in enumerate(offsets):
+            if job.wavelengths > 0 and multi:
+                # Each supersample integrates the spectrum at its own points (spectrum.py).
+                shift = wavelength_shift(index, len(offsets))
+                uniforms.apply(program, uniforms.spectral_uniforms(job.material, job.wavelengths,
+                                                                   shift))
             targets.sample_fbo.use()
             targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             ctx.enable(moderngl.DEPTH_TEST)
