@@ -18,7 +18,7 @@ from accuracy_grid import REFERENCE, RGB_REFERENCE, SAMPLES, WAVELENGTHS
 
 GUIDE_START, GUIDE_END = "<!-- GUIDE -->", "<!-- /GUIDE -->"
 METRICS = ("psnr_db", "de2000_mean", "de2000_p95", "flip")
-CSV_COLUMNS = ("preset", "variant", "samples", "wavelengths", "aa", "ms", *METRICS,
+CSV_COLUMNS = ("preset", "variant", "samples", "wavelengths", "aa", "ms", "ms_measured", *METRICS,
                "flip_sampling", "on_flip_front", "on_de2000_p95_front")
 
 
@@ -63,14 +63,27 @@ def name(row: dict) -> str:
     return f"{row['samples']} spp × {row['wavelengths']} wl{', analytic' if row['aa'] == 'analytic' else ''}"
 
 
-def tier_table(rows: list[dict]) -> list[str]:
-    lines = ["| preset | tier | setting | ms | × draft | FLIP | ΔE00 p95 | best FLIP in the same time "
-             "| on the front |", "|---|---|---|---|---|---|---|---|---|"]
+def tier_table(rows: list[dict], paired: dict) -> list[str]:
+    lines = ["| preset | tier | setting | ms (model) | × draft (model) | × draft (paired) | FLIP "
+             "| ΔE00 p95 | best FLIP in the same time | on the front |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for p in placement(rows):
         row = tier_point(base_rows(rows, p["preset"]), p["tier"])
+        ratio = 1.0 if p["tier"] == "draft" else paired.get(p["preset"], {}).get(p["tier"])
         lines.append(f"| {p['preset']} | {p['tier']} | {name(row)} | {p['ms']:.1f} "
-                     f"| {p['ratio']:.2f} | {fmt(p['flip'])} | {fmt(p['de2000_p95'], 2)} "
-                     f"| {fmt(p['front_flip'])} | {'yes' if p['on_front'] else 'no'} |")
+                     f"| {p['ratio']:.2f} | {fmt(ratio, 2)} | {fmt(p['flip'])} "
+                     f"| {fmt(p['de2000_p95'], 2)} | {fmt(p['front_flip'])} "
+                     f"| {'yes' if p['on_front'] else 'no'} |")
+    return lines
+
+
+def time_model_table(info: dict) -> list[str]:
+    lines = ["| preset | a (ms) | b (ms per sample) | c (ms per sample·wavelength) "
+             "| d (extra for analytic AA) | old draft (1 spp RGB analytic) × draft, paired |",
+             "|---|---|---|---|---|---|"]
+    for preset, (a, b, c, d) in info.get("time_model", {}).items():
+        old = info.get("tier_ratios", {}).get(preset, {}).get("old draft")
+        lines.append(f"| {preset} | {a:.2f} | {b:.2f} | {c:.3f} | {d:.3f} | {fmt(old, 2)} |")
     return lines
 
 
@@ -127,14 +140,22 @@ def convergence_table(facts: list[dict]) -> list[str]:
 
 
 def front_tables(rows: list[dict]) -> list[str]:
+    """Per preset, the union of its two fronts, fastest first, marked by which front."""
     out = []
     for preset in dict.fromkeys(r["preset"] for r in rows):
         found = base_rows(rows, preset)
-        for key, label in (("flip", "FLIP"), ("de2000_p95", "ΔE00 p95")):
-            line = front(found, key)
-            out += [f"**{preset}, time against {label}:** " + "; ".join(
-                f"{name(r)}: {r['ms']:.1f} ms, {fmt(r[key], 3 if key == 'flip' else 2)}"
-                for r in line), ""]
+        on_flip = {_point(r) for r in front(found, "flip")}
+        on_de = {_point(r) for r in front(found, "de2000_p95")}
+        out += [f"**{preset}**", "", "| setting | ms (model) | ms (measured) | FLIP | ΔE00 p95 "
+                "| front |", "|---|---|---|---|---|---|"]
+        for r in sorted(found, key=lambda r: r["ms"]):
+            marks = [label for label, points in (("FLIP", on_flip), ("ΔE00", on_de))
+                     if _point(r) in points]
+            if marks:
+                out.append(f"| {name(r)} | {r['ms']:.1f} | {r.get('ms_measured', r['ms']):.1f} "
+                           f"| {fmt(r['flip'])} | {fmt(r['de2000_p95'], 2)} "
+                           f"| {', '.join(marks)} |")
+        out.append("")
     return out
 
 
@@ -188,9 +209,21 @@ def to_markdown(rows: list[dict], facts: list[dict], info: dict, guide: str) -> 
         "## Where the tiers sit",
         "",
         "Each tier's time over draft's on the same preset, its errors, and the best FLIP any "
-        "measured point reaches in at most the same time (the front under it).",
+        "measured point reaches in at most the same time (the front under it). Times: "
+        "`model` is the fitted cost model below (what the fronts, the tiers and the "
+        "quality=auto table use); `paired` is the tier and draft rendered in 7 alternating "
+        "pairs, median of the pairs' ratios.",
         "",
-        *tier_table(rows),
+        *tier_table(rows, info.get("tier_ratios", {})),
+        "",
+        "### Time model",
+        "",
+        "On a shared 2-core machine the fastest of 3 renders of one point still scatters by "
+        "10-50 %, enough to reorder neighbouring points. Per preset, ms = a + b·samples + "
+        "(c + d·[analytic])·samples·max(wavelengths, 3) is fitted (non-negative least squares "
+        "on relative error) to all the preset's measured points; docs/accuracy.csv has both.",
+        "",
+        *time_model_table(info),
         "",
         "## Model error against sampling error",
         "",

@@ -12,7 +12,8 @@ import json
 
 
 def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
-    from opaline.model.auto import preset_digest
+    from opaline.model.auto import difficulty, preset_digest
+    from opaline.model.params import Material
     from opaline.model.presets import get_preset
     from opaline.resources import sources_digest
 
@@ -32,7 +33,10 @@ def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
             found = {(r["samples"], r["wavelengths"], r["aa"]): r
                      for r in rows if r["preset"] == preset and r["variant"] == v}
             fact = next(f for f in facts if f["preset"] == preset and f["variant"] == v)
-            materials.append({"variant": v, "difficulty": fact["difficulty"],
+            made = Material(**fact["material"])
+            materials.append({"variant": v,
+                              "difficulty": difficulty(made, info["size"], info["size"], 1.0),
+                              "theta": [fact["material"]["theta1"], fact["material"]["theta2"]],
                               "flip": [round(found[k]["flip"], 5) for k in points],
                               "de2000_p95": [round(found[k]["de2000_p95"], 4) for k in points]})
         presets[preset] = {

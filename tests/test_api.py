@@ -242,7 +242,7 @@ def test_web_page_served_when_present(tmp_path):
     ("width=8", "width=", "[16 … 2048]"),
     ("samples=0", "samples=", "[1 … 1024]"),
     ("albedo=0.1,2,0.3", "albedo", "[0 … 1]"),
-    ("wavelengths=2", "wavelengths=", "3 … 128"),
+    ("wavelengths=3", "wavelengths=", "4 … 128"),
     ("exposure=0", "exposure=", "(0 … 1000]"),
 ])
 def test_out_of_range_query_is_422_naming_field_and_range(client, query, field, allowed):

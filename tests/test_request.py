@@ -33,7 +33,7 @@ def test_builtin_defaults_fill_everything():
     assert (job.width, job.height, job.format) == (256, 256, "png")
     assert job.quality == "standard" and job.transparent is False
     for field in dataclasses.fields(Job):
-        if field.name not in ("light_azimuth", "light_elevation"):
+        if field.name not in ("light_azimuth", "light_elevation", "auto"):
             assert getattr(job, field.name) is not None, field.name
 
 
@@ -131,7 +131,7 @@ def test_cache_key_stable_across_processes():
     code = ("from opaline.model.params import RenderRequest; from opaline.model.presets import get_preset; "
             "from opaline.model.request import resolve; p = get_preset('cd-rom'); "
             "print(resolve(RenderRequest(preset='cd-rom', mu_f=3.0), p).cache_key(p.scene_key()))")
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONHASHSEED": "12345"}
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "service"), "PYTHONHASHSEED": "12345"}
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True,
                          text=True, check=True, timeout=60)
     assert out.stdout.strip() == key("cd-rom", mu_f=3.0)
@@ -175,8 +175,12 @@ def test_cache_key_changes_with_preset():
 
 
 def test_canonical_form_is_json():
-    """The canonical form serialises to JSON with every Job field."""
+    """The canonical form serialises to JSON with every Job field (a tier job has no auto
+    pick, and leaves the field out so its key stays what it was before quality=auto)."""
     job = resolve(RenderRequest(preset="nacre"))
     data = json.loads(json.dumps(job.canonical()))
-    assert set(data) == {f.name for f in dataclasses.fields(Job)}
+    assert set(data) == {f.name for f in dataclasses.fields(Job)} - {"auto"}
+    picked = resolve(RenderRequest(preset="nacre", quality="auto"))
+    assert set(json.loads(json.dumps(picked.canonical()))) == {
+        f.name for f in dataclasses.fields(Job)}
     assert data["material"]["mu_f"] == job.material.mu_f

@@ -35,9 +35,20 @@ def cmd_render(args: argparse.Namespace) -> None:
         args.format,
         {"quality": args.quality, "transparent": args.transparent or None},
     )
+    if args.verbose:
+        print(chosen_setting(resolve(request)), file=sys.stderr)
     with LocalRenderer(args.backend) as renderer:
         data = renderer.render_bytes(request)
     write_atomic(Path(args.output), data)
+
+
+def chosen_setting(job) -> str:
+    """What a render will use; for quality=auto, also what it picked and why."""
+    from opaline.model.auto import describe
+
+    line = (f"quality {job.quality}: samples={job.samples} wavelengths={job.wavelengths} "
+            f"aa={job.aa}")
+    return f"{line} ({describe(job)})" if job.auto is not None else line
 
 
 def cmd_mdf(args: argparse.Namespace) -> None:
@@ -119,9 +130,14 @@ def make_parser() -> argparse.ArgumentParser:
         "--format", choices=get_args(ImageFormat), help="output format (default png)"
     )
     render.add_argument(
-        "--quality", choices=get_args(Quality), help="quality tier (default standard)"
+        "--quality", choices=get_args(Quality),
+        help="quality tier (default standard); auto: the cheapest measured setting within "
+        "--set max_flip=… / max_delta_e=… (FLIP 0.05 when neither is set)"
     )
     render.add_argument("--transparent", action="store_true", help="transparent PNG background")
+    render.add_argument("-v", "--verbose", action="store_true",
+                        help="print the samples, wavelengths and AA used (and what "
+                        "quality=auto picked) on stderr")
     render.add_argument("-o", "--output", required=True, help="output file")
     add_common(render)
     render.set_defaults(func=cmd_render)
