@@ -224,5 +224,6 @@ def auto_headers(job) -> dict[str, str]:
 def describe(job) -> str:
     """One line for the CLI's verbose output."""
     headers = auto_headers(job)
+    headers.pop("X-Opaline-Auto-Setting", None)  # the CLI line states the setting already
     return "; ".join(f"{k.removeprefix('X-Opaline-Auto-').lower()}: {v}"
                      for k, v in headers.items())
