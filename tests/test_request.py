@@ -157,7 +157,7 @@ def test_cache_key_changes_with_material(field, value):
 @pytest.mark.parametrize(
     ("field", "value"),
     [("width", 128), ("height", 128), ("format", "png16"), ("format", "npy"), ("quality", "draft"),
-     ("quality", "high"), ("samples", 3), ("wavelengths", 8), ("aa", "analytic"), ("exposure", 2.0),
+     ("quality", "high"), ("samples", 3), ("wavelengths", 32), ("aa", "none"), ("exposure", 2.0),
      ("tonemap", "none"), ("transparent", True), ("light_azimuth", 30.0),
      ("light_elevation", 10.0)],
 )
