@@ -142,9 +142,10 @@ def main() -> None:
 
 
 def write_outputs(data: dict, out: Path, table: bool) -> None:
+    from accuracy_csv import to_csv
     from accuracy_grid import fit_times
     from accuracy_plot import plot
-    from accuracy_report import kept_guide, to_csv, to_markdown
+    from accuracy_report import kept_guide, to_markdown
     from accuracy_table import quality_table
     from opaline.model.auto import TABLE_PATH
 

@@ -5,6 +5,11 @@ from __future__ import annotations
 TIER_ORDER = ("draft", "standard", "high")
 
 
+def point_of(row: dict) -> tuple:
+    """A row's point: (samples, wavelengths, aa)."""
+    return row["samples"], row["wavelengths"], row["aa"]
+
+
 def base_rows(rows: list[dict], preset: str) -> list[dict]:
     return [r for r in rows if r["preset"] == preset and r["variant"] == "base"]
 

@@ -8,49 +8,13 @@ converged spectrum (and, for wavelengths 0, against the RGB model converged).
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from pathlib import Path
 
-from accuracy_front import TIER_ORDER, base_rows, front, placement, tier_point
+from accuracy_front import TIER_ORDER, base_rows, front, placement, point_of, tier_point
 from accuracy_grid import REFERENCE, RGB_REFERENCE, SAMPLES, WAVELENGTHS
 
 GUIDE_START, GUIDE_END = "<!-- GUIDE -->", "<!-- /GUIDE -->"
-METRICS = ("psnr_db", "de2000_mean", "de2000_p95", "flip")
-CSV_COLUMNS = ("preset", "variant", "samples", "wavelengths", "aa", "ms", "ms_measured", *METRICS,
-               "flip_sampling", "on_flip_front", "on_de2000_p95_front")
-
-
-def to_csv(rows: list[dict], info: dict) -> bytes:
-    fronts = {}
-    for preset in dict.fromkeys(r["preset"] for r in rows):
-        found = base_rows(rows, preset)
-        for key in ("flip", "de2000_p95"):
-            fronts.update({(preset, _point(r), key): True for r in front(found, key)})
-    out = io.StringIO()
-    writer = csv.DictWriter(out, fieldnames=[*CSV_COLUMNS, "size", "cpu", "gl"],
-                            lineterminator="\n")
-    writer.writeheader()
-    for row in rows:
-        base = row["variant"] == "base"
-        flags = {f"on_{k}_front": int(base and (row["preset"], _point(row), k) in fronts)
-                 for k in ("flip", "de2000_p95")}
-        writer.writerow({**{k: _csv_value(row.get(k)) for k in CSV_COLUMNS}, **flags,
-                         "size": info["size"], "cpu": info["cpu"], "gl": info["gl"]})
-    return out.getvalue().encode()
-
-
-def _point(row: dict) -> tuple:
-    return row["samples"], row["wavelengths"], row["aa"]
-
-
-def _csv_value(value):
-    if isinstance(value, float):
-        return "inf" if math.isinf(value) else f"{value:.6g}"
-    return "" if value is None else value
-
-
 def fmt(value, digits: int = 3) -> str:
     if value is None:
         return ""
@@ -94,7 +58,7 @@ def model_table(rows: list[dict], facts: list[dict]) -> list[str]:
     for f in facts:
         if f["variant"] != "base":
             continue
-        found = {_point(r): r for r in base_rows(rows, f["preset"])}
+        found = {point_of(r): r for r in base_rows(rows, f["preset"])}
         rgb = [found.get((n, 0, "none"), {}).get("flip_sampling") for n in (1, 4, 16)]
         lines.append(f"| {f['preset']} | {fmt(f['model_flip'])} | {fmt(f['model_de2000_p95'], 2)} "
                      f"| {' | '.join(fmt(v) for v in rgb)} "
@@ -108,7 +72,7 @@ def aa_table(rows: list[dict]) -> list[str]:
     lines = ["| preset | " + " | ".join(f"{n} spp {aa}" for n, aa in columns)
              + " | 1 spp analytic beats 4 spp none |", "|---" * (len(columns) + 2) + "|"]
     for preset in dict.fromkeys(r["preset"] for r in rows):
-        found = {_point(r): r for r in base_rows(rows, preset)}
+        found = {point_of(r): r for r in base_rows(rows, preset)}
         if (1, 0, "analytic") not in found:
             continue
         values = [found[(n, 0, aa)]["flip_sampling"] for n, aa in columns]
@@ -121,7 +85,7 @@ def wavelength_table(rows: list[dict], samples: int) -> list[str]:
     lines = ["| preset | " + " | ".join(f"{w} wl" for w in WAVELENGTHS) + " |",
              "|---" * (len(WAVELENGTHS) + 1) + "|"]
     for preset in dict.fromkeys(r["preset"] for r in rows):
-        found = {_point(r): r for r in base_rows(rows, preset)}
+        found = {point_of(r): r for r in base_rows(rows, preset)}
         lines.append(f"| {preset} | " + " | ".join(
             fmt(found[(samples, w, "none")]["flip"]) for w in WAVELENGTHS) + " |")
     return lines
@@ -144,13 +108,13 @@ def front_tables(rows: list[dict]) -> list[str]:
     out = []
     for preset in dict.fromkeys(r["preset"] for r in rows):
         found = base_rows(rows, preset)
-        on_flip = {_point(r) for r in front(found, "flip")}
-        on_de = {_point(r) for r in front(found, "de2000_p95")}
+        on_flip = {point_of(r) for r in front(found, "flip")}
+        on_de = {point_of(r) for r in front(found, "de2000_p95")}
         out += [f"**{preset}**", "", "| setting | ms (model) | ms (measured) | FLIP | ΔE00 p95 "
                 "| front |", "|---|---|---|---|---|---|"]
         for r in sorted(found, key=lambda r: r["ms"]):
             marks = [label for label, points in (("FLIP", on_flip), ("ΔE00", on_de))
-                     if _point(r) in points]
+                     if point_of(r) in points]
             if marks:
                 out.append(f"| {name(r)} | {r['ms']:.1f} | {r.get('ms_measured', r['ms']):.1f} "
                            f"| {fmt(r['flip'])} | {fmt(r['de2000_p95'], 2)} "

@@ -27,7 +27,7 @@ def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
             keys = found if keys is None else keys & found
         base = {(r["samples"], r["wavelengths"], r["aa"]): r
                 for r in rows if r["preset"] == preset and r["variant"] == "base"}
-        points = sorted(keys, key=lambda k: base[k]["ms"])
+        points = sorted(keys, key=lambda k: (base[k]["ms"], k))  # ties in a fixed order
         materials = []
         for v in variants:
             found = {(r["samples"], r["wavelengths"], r["aa"]): r

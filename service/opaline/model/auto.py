@@ -157,7 +157,8 @@ def pick(preset_name: str, material: Material, width: int, height: int, exposure
         delta_e = max(m["de2000_p95"][index] for m in judged)
         if (max_flip is None or flip <= scale * max_flip) and (
                 max_delta_e is None or delta_e <= scale * max_delta_e):
-            if best is None or point["ms"] < best[0]["ms"]:
+            # The fastest; of equally fast ones, the more accurate.
+            if best is None or (point["ms"], flip) < (best[0]["ms"], best[1]):
                 best = (point, flip, delta_e)
     if best is None:
         return fall_back("no measured setting meets the target")
