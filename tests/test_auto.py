@@ -146,9 +146,15 @@ def test_auto_without_a_budget_aims_at_flip_005():
     assert job.auto.max_flip == auto.DEFAULT_MAX_FLIP == 0.05
 
 
-def test_a_budget_with_a_tier_is_refused():
-    with pytest.raises(ValueError, match="quality 'auto'"):
+def test_a_budget_with_a_tier_is_refused_naming_the_field():
+    from pydantic import ValidationError
+
+    from opaline.model.params import describe_errors
+
+    with pytest.raises(ValidationError) as caught:
         RenderRequest(quality="draft", max_flip=0.05)
+    (line,) = describe_errors(caught.value)
+    assert line.startswith("max_flip=0.05") and "quality 'auto'" in line
 
 
 def test_request_fields_still_override_the_pick():

@@ -14,8 +14,8 @@ from pydantic import (
     ConfigDict,
     Field,
     ValidationError,
+    ValidationInfo,
     field_validator,
-    model_validator,
 )
 
 TWO_PI = 2.0 * math.pi
@@ -143,12 +143,14 @@ class RenderFields(MaterialFields):
     def _wavelengths_in_range(cls, value: int | None) -> int | None:
         return wavelengths_ok(value)
 
-    @model_validator(mode="after")
-    def _budget_needs_auto(self):
-        if self.quality not in (None, "auto") and (self.max_flip or self.max_delta_e):
-            raise ValueError("max_flip and max_delta_e choose the setting: use quality 'auto'"
-                             " (or leave quality out), not a tier")
-        return self
+    @field_validator("max_flip", "max_delta_e")
+    @classmethod
+    def _budget_needs_auto(cls, value: float | None, info: ValidationInfo) -> float | None:
+        # quality is declared (so validated) before the budgets.
+        if value is not None and info.data.get("quality") not in (None, "auto"):
+            raise ValueError("an error budget chooses the setting: use quality 'auto' (or leave"
+                             " quality out), not a tier")
+        return value
 
 
 class RenderRequest(RenderFields):
