@@ -25,7 +25,7 @@ RANGES = {
     "ex": (0, 1e6), "ey": (0, 1e6), "mu_f": (0, 1000), "alpha": (0, 1000), "beta": (0, 1000),
     "theta1": (-2 * math.pi, 2 * math.pi), "theta2": (-2 * math.pi, 2 * math.pi),
     "kd": (0, 100), "ks": (0, 100), "albedo": (0, 1), "f0": (0, 1),
-    "width": (16, 2048), "height": (16, 2048), "samples": (1, 1024), "wavelengths": (3, 128),
+    "width": (16, 2048), "height": (16, 2048), "samples": (1, 1024), "wavelengths": (4, 128),
     "exposure": (0, 1000), "light_azimuth": (-360, 360), "light_elevation": (-90, 90),
 }
 NUMBER = re.compile(r"(-?\d+(?:\.\d+)?(?:e[+-]?\d+)?)(π)?")

@@ -43,6 +43,7 @@ def test_wheel_contains_every_shader_and_preset(wheel):
     for preset in (ROOT / "presets").glob("*.toml"):
         assert f"opaline/_presets/{preset.name}" in names
     assert any(name.endswith("entry_points.txt") for name in names)
+    assert "opaline/model/quality_table.json" in names  # quality=auto's measurements
 
 
 # -- the runtime import closure --------------------------------------------------------------

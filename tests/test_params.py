@@ -121,18 +121,19 @@ def test_albedo_components(index):
         RenderRequest(albedo=(0.5, 0.5))
 
 
-@pytest.mark.parametrize("value", [0, 3, 4, 64, 127, 128])
+@pytest.mark.parametrize("value", [0, 4, 5, 64, 127, 128])
 def test_wavelengths_accepted(value):
-    """wavelengths takes 0 (the paper's RGB) and 3 … 128."""
+    """wavelengths takes 0 (the paper's RGB) and 4 … 128."""
     assert RenderRequest(wavelengths=value).wavelengths == value
 
 
-@pytest.mark.parametrize("value", [1, 2, 129, -1, 1000])
+@pytest.mark.parametrize("value", [1, 2, 3, 129, -1, 1000])
 def test_wavelengths_refused(value):
-    """wavelengths refuses 1, 2, 129 and the like, naming the field and what is allowed."""
+    """wavelengths refuses 1-3 (less accurate than RGB), 129 and the like, naming the field
+    and what is allowed."""
     (line,) = errors(wavelengths=value)
     assert f"wavelengths={value}" in line
-    assert "3" in line and "128" in line and "0" in line
+    assert "4 … 128" in line and "0" in line
 
 
 def test_describe_errors_example():

@@ -414,3 +414,17 @@ def test_mdf_plot_orientation():
     # ey >> ex: the lobe is narrow along hy, so a pixel up the hy axis is darker than across hx.
     mid = size // 2
     assert plot[2, mid, 0] < plot[mid, 2, 0]
+
+
+@pytest.mark.parametrize(("a", "b"), [(0.5, 0.0), (3.0, 3.0), (9.0, 2.0), (20.0, 0.3)])
+def test_multipeak_filtered_is_the_box_average_over_a_linear_phase(a, b):
+    """With the phase x0 + a·u + b·v over the box (u, v in [-½, ½]), the filtered MDF is the
+    mean of the unfiltered one: cos(x0)·sinc(a/2)·sinc(b/2). One sinc of |a| + |b| (the
+    old filter) misses it by 0.16 at a = b = 3."""
+    hx, hy, hz, mu_f = 0.3, 0.2, 0.9, 8.5
+    x0 = 2.0 * math.pi * mu_f * np.hypot(hx, hy)
+    u = (np.arange(400) + 0.5) / 400 - 0.5
+    phase = x0 + a * u[:, None] + b * u[None, :]
+    expected = 0.5 * hz * (np.mean(np.cos(phase)) + 1.0)
+    got = float(ref.mdf_multipeak_filtered(hx, hy, hz, mu_f, 1.0, 1.0, a, b))
+    assert got == pytest.approx(expected, abs=1e-5)

@@ -34,7 +34,7 @@ def test_builtin_defaults_fill_everything():
     assert job.quality == "standard" and job.transparent is False
     for field in dataclasses.fields(Job):
         # None means "the preset's" (light, camera) or "no environment".
-        if field.name not in ("light_azimuth", "light_elevation") and not field.name.startswith(
+        if field.name not in ("light_azimuth", "light_elevation", "auto") and not field.name.startswith(
                 ("camera_", "environment")):
             assert getattr(job, field.name) is not None, field.name
 
@@ -163,7 +163,7 @@ def test_cache_key_changes_with_material(field, value):
 @pytest.mark.parametrize(
     ("field", "value"),
     [("width", 128), ("height", 128), ("format", "png16"), ("format", "npy"), ("quality", "draft"),
-     ("quality", "high"), ("samples", 3), ("wavelengths", 8), ("aa", "analytic"), ("exposure", 2.0),
+     ("quality", "high"), ("samples", 3), ("wavelengths", 32), ("aa", "none"), ("exposure", 2.0),
      ("tonemap", "none"), ("transparent", True), ("light_azimuth", 30.0),
      ("light_elevation", 10.0)],
 )
@@ -181,8 +181,12 @@ def test_cache_key_changes_with_preset():
 
 
 def test_canonical_form_is_json():
-    """The canonical form serialises to JSON with every Job field."""
+    """The canonical form serialises to JSON with every Job field (a tier job has no auto
+    pick, and leaves the field out so its key stays what it was before quality=auto)."""
     job = resolve(RenderRequest(preset="nacre"))
     data = json.loads(json.dumps(job.canonical()))
-    assert set(data) == {f.name for f in dataclasses.fields(Job)}
+    assert set(data) == {f.name for f in dataclasses.fields(Job)} - {"auto"}
+    picked = resolve(RenderRequest(preset="nacre", quality="auto"))
+    assert set(json.loads(json.dumps(picked.canonical()))) == {
+        f.name for f in dataclasses.fields(Job)}
     assert data["material"]["mu_f"] == job.material.mu_f

@@ -5,21 +5,42 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from opaline.model.spectrum import ANCHORS_NM, rgb_weights, rotation_at, sample_wavelengths
+from opaline.model.spectrum import (
+    ANCHORS_NM,
+    rgb_weights,
+    rotation_at,
+    sample_wavelengths,
+    wavelength_shift,
+)
 
 
-def test_rotation_passes_through_the_anchors_and_extends_linearly():
-    """θ(612) = 0, θ(549) = θ1, θ(465) = θ2, and the end segments continue straight."""
+def test_rotation_passes_through_the_anchors_and_holds_beyond_them():
+    """θ(612) = 0, θ(549) = θ1, θ(465) = θ2, linear between; θ2 below 465 nm and 0 above
+    612 nm, so at θ = ±2π the spectrum spans no more rotation than the user asked for."""
     theta = rotation_at(np.array(ANCHORS_NM), 0.3, 0.7)
     np.testing.assert_allclose(theta, [0.0, 0.3, 0.7], atol=1e-15)
+    assert rotation_at(np.array([507.0]), 0.3, 0.7)[0] == pytest.approx(0.5)
     beyond = rotation_at(np.array([380.0, 400.0, 700.0, 780.0]), 0.3, 0.7)
-    assert np.diff(beyond[:2]) == pytest.approx((0.7 - 0.3) / (465 - 549) * 20)
-    assert np.diff(beyond[2:]) == pytest.approx((0.0 - 0.3) / (612 - 549) * 80)
+    np.testing.assert_allclose(beyond, [0.7, 0.7, 0.0, 0.0])
+    extreme = rotation_at(np.linspace(380.0, 780.0, 401), -2 * np.pi, 2 * np.pi)
+    assert extreme.min() == pytest.approx(-2 * np.pi) and extreme.max() == pytest.approx(2 * np.pi)
 
 
 def test_wavelengths_are_bin_midpoints_over_the_visible_range():
     """N bins of equal width over 380 … 780 nm, sampled at their centres."""
     np.testing.assert_allclose(sample_wavelengths(4), [430.0, 530.0, 630.0, 730.0])
+    np.testing.assert_allclose(sample_wavelengths(4, 0.0), [380.0, 480.0, 580.0, 680.0])
+
+
+def test_supersamples_spread_their_wavelengths_over_the_bins():
+    """One sample takes the midpoints; N samples take N distinct shifts that cover [0, 1)
+    with no gap wider than 2/N (golden-ratio sequence), so N·W points integrate the spectrum."""
+    assert wavelength_shift(0, 1) == 0.5
+    for n in (2, 4, 16, 64):
+        shifts = np.sort([wavelength_shift(i, n) for i in range(n)])
+        assert len(np.unique(shifts)) == n
+        gaps = np.diff(np.concatenate([shifts, [shifts[0] + 1.0]]))
+        assert gaps.max() <= 2.0 / n + 1e-12
 
 
 @pytest.mark.parametrize("count", [3, 16, 128])

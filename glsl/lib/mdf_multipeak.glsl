@@ -1,10 +1,13 @@
 // Eqs. 3-4: multi-peak MDF, ½·max(hz,0)·(cos(2π·mu_f·r) + 1), r = sqrt(α·hx² + β·hy²).
 // The phase is reduced to [0, 1) cycles before the cosine so float trig never
-// sees a large argument. AA_ANALYTIC box-filters the cosine over the pixel's
-// phase footprint: mean of cos over [x-Δ/2, x+Δ/2] is cos(x)·sinc(Δ/2). With N
-// supersamples each covers about 1/√N of the pixel's width, so the footprint
-// is scaled by u_aa_scale = 1/√N; filtering the whole pixel on every sample
-// would blur twice.
+// sees a large argument. AA_ANALYTIC box-filters the cosine over the sample's
+// share of the pixel: across the box the phase is x0 + a·u + b·v (a, b: its
+// screen derivatives, u, v in [-½, ½]), and the mean of cos over it is
+// cos(x0)·sinc(a/2)·sinc(b/2), a product of two sincs. (One sinc of fwidth =
+// |a| + |b| blurred diagonal bands: docs/accuracy.md.) N supersamples on a
+// well-stratified pattern each own a cell about 1/√N of the pixel's width, so the
+// box is scaled by u_aa_scale = 1/√N; the cells tile the pixel, so the filtered
+// samples average to the pixel's box.
 #ifndef MDF_MULTIPEAK_GLSL
 #define MDF_MULTIPEAK_GLSL
 #include "lib/common.glsl"
@@ -27,7 +30,8 @@ float mdf_multipeak(real2 h, float hz) {
     float phase = TWO_PI * float(cycles - floor(cycles));
     float band = cos(phase);
 #ifdef AA_ANALYTIC
-    band *= sinc_half(TWO_PI * u_aa_scale * fwidth(float(cycles)));
+    float box = TWO_PI * u_aa_scale;
+    band *= sinc_half(box * abs(dFdx(float(cycles)))) * sinc_half(box * abs(dFdy(float(cycles))));
 #endif
     return 0.5 * max(hz, 0.0) * (band + 1.0);
 }

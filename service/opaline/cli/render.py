@@ -48,6 +48,10 @@ def cmd_render(args: argparse.Namespace) -> None:
         log.info("preset=%s %dx%d %s quality=%s samples=%d wavelengths=%d aa=%s cost=%d",
                  job.preset, job.width, job.height, job.format, job.quality, job.samples,
                  job.wavelengths, job.aa, job.cost)
+        if job.auto is not None:
+            from opaline.model.auto import describe
+
+            log.info("quality=auto picked: %s", describe(job))
         started = time.perf_counter()
         data = renderer.render_job(job)
         log.info("rendered in %.3f s (%d bytes)", time.perf_counter() - started, len(data))
@@ -99,7 +103,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="output format (default: from the -o extension; png16 needs "
                              "--format png16 with .png)")
     render.add_argument("--quality", choices=get_args(Quality),
-                        help="quality tier (default standard)")
+                        help="quality tier (default standard); auto: the cheapest measured "
+                             "setting within --set max_flip=… / max_delta_e=… (FLIP 0.05 when "
+                             "neither is set)")
     render.add_argument("--transparent", action="store_true",
                         help="transparent PNG background")
     render.add_argument("--mesh", metavar="FILE",

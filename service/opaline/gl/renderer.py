@@ -30,6 +30,7 @@ from opaline.lru import BudgetLRU
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job
 from opaline.model.sampling import sample_offsets
+from opaline.model.spectrum import wavelength_shift
 
 log = logging.getLogger(__name__)
 NORMAL_MAP_UNIT = 1
@@ -207,6 +208,11 @@ class Renderer(Probes):
         for index, (dx, dy) in enumerate(offsets):
             if index and should_stop is not None and should_stop():
                 raise Cancelled(f"stopped after {index} of {len(offsets)} samples")
+            if job.wavelengths > 0 and multi:
+                # Each supersample integrates the spectrum at its own points (spectrum.py).
+                shift = wavelength_shift(index, len(offsets))
+                uniforms.apply(program, uniforms.spectral_uniforms(job.material, job.wavelengths,
+                                                                   shift))
             targets.sample_fbo.use()
             targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             jitter = (2.0 * dx / width, 2.0 * dy / height)

@@ -9,7 +9,7 @@ import numpy as np
 
 from opaline.gl import physical
 from opaline.model.params import Material
-from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
+from opaline.model.spectrum import CENTRE, rgb_weights, rotation_at, sample_wavelengths
 
 
 def mdf_defines(
@@ -41,7 +41,9 @@ def _cos_sin(theta: np.ndarray) -> list[tuple[float, float]]:
     return [(math.cos(a), math.sin(a)) for a in np.atleast_1d(theta)]
 
 
-def material_uniforms(material: Material, wavelengths: int = 0) -> dict[str, object]:
+def material_uniforms(
+    material: Material, wavelengths: int = 0, shift: float = CENTRE
+) -> dict[str, object]:
     values: dict[str, object] = {
         "u_ex": material.ex,
         "u_ey": material.ey,
@@ -54,13 +56,19 @@ def material_uniforms(material: Material, wavelengths: int = 0) -> dict[str, obj
         "u_f0": material.f0,
     }
     if wavelengths > 0:
-        theta = rotation_at(sample_wavelengths(wavelengths), material.theta1, material.theta2)
-        values["u_spectral_rotation"] = _cos_sin(theta)
-        values["u_spectral_weight"] = [tuple(w) for w in rgb_weights(wavelengths)]
+        values.update(spectral_uniforms(material, wavelengths, shift))
     else:
         values["u_rotation"] = _cos_sin(np.array([0.0, material.theta1, material.theta2]))
     values.update(physical.uniforms(material, wavelengths))
     return values
+
+
+def spectral_uniforms(material: Material, wavelengths: int, shift: float) -> dict[str, object]:
+    """Rotations and weights of ``wavelengths`` wavelengths at ``shift`` through their bins
+    (spectrum.wavelength_shift): set again before each supersample."""
+    theta = rotation_at(sample_wavelengths(wavelengths, shift), material.theta1, material.theta2)
+    return {"u_spectral_rotation": _cos_sin(theta),
+            "u_spectral_weight": [tuple(w) for w in rgb_weights(wavelengths, shift)]}
 
 
 def apply(program: moderngl.Program, values: dict[str, object]) -> None:

@@ -10,7 +10,14 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
 
 from opaline.model import messages
 
@@ -24,7 +31,7 @@ TWO_PI = 2.0 * math.pi
 MdfName = Literal["ashikhmin", "multipeak"]
 ImageFormat = Literal["png", "png16", "npy"]
 Tonemap = Literal["none", "reinhard", "aces"]
-Quality = Literal["draft", "standard", "high", "reference"]
+Quality = Literal["draft", "standard", "high", "reference", "auto"]
 AntiAlias = Literal["none", "analytic"]
 
 Exponent = Annotated[float, Field(ge=0.0, le=1e6)]
@@ -38,9 +45,13 @@ Pixels = Annotated[int, Field(ge=16, le=2048)]
 STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
 
+MIN_WAVELENGTHS = 4  # 1-3 score worse than the RGB model at every sample count (docs/accuracy.md)
+
+
 def wavelengths_ok(value: int | None) -> int | None:
-    if value is not None and value != 0 and not 3 <= value <= 128:
-        raise ValueError("must be 0 (the paper's RGB rotations) or 3 … 128")
+    if value is not None and value != 0 and not MIN_WAVELENGTHS <= value <= 128:
+        raise ValueError("must be 0 (the paper's RGB rotations) or 4 … 128 (1-3 wavelengths"
+                         " are less accurate than the RGB model)")
     return value
 
 
@@ -116,16 +127,25 @@ class RenderFields(MaterialFields, SceneFields):
     )
     quality: Quality | None = Field(
         None,
-        description="Tier bundling samples, wavelengths and anti-aliasing: draft, standard, high, reference.",
+        description="Tier bundling samples, wavelengths and anti-aliasing: draft, standard, high,"
+        " reference, or auto (the cheapest measured setting within max_flip / max_delta_e).",
+    )
+    # quality="auto" (model/auto.py): the cheapest measured setting within these budgets.
+    max_flip: Annotated[float, Field(gt=0.0, le=1.0)] | None = Field(
+        None, description="With quality 'auto': largest FLIP against a converged render, (0, 1]."
+    )
+    max_delta_e: Annotated[float, Field(gt=0.0, le=100.0)] | None = Field(
+        None,
+        description="With quality 'auto': largest CIEDE2000 (95th percentile) against a converged render, (0, 100].",
     )
     samples: Annotated[int, Field(ge=1, le=1024)] | None = Field(
         None, description="Samples per pixel, 1 … 1024 (default: the tier's)."
     )
-    # Bounds for UIs live in the schema; the validator gives the exact rule (0 or 3 … 128).
+    # Bounds for UIs live in the schema; the validator gives the exact rule (0 or 4 … 128).
     wavelengths: int | None = Field(
         None,
         json_schema_extra=wavelengths_schema,
-        description="0 = the paper's RGB rotations, else 3 … 128 wavelengths integrated with CIE 1931 (default: the tier's).",
+        description="0 = the paper's RGB rotations, else 4 … 128 wavelengths integrated with CIE 1931 (default: the tier's).",
     )
     aa: AntiAlias | None = Field(
         None,
@@ -149,6 +169,15 @@ class RenderFields(MaterialFields, SceneFields):
     @classmethod
     def _wavelengths_in_range(cls, value: int | None) -> int | None:
         return wavelengths_ok(value)
+
+    @field_validator("max_flip", "max_delta_e")
+    @classmethod
+    def _budget_needs_auto(cls, value: float | None, info: ValidationInfo) -> float | None:
+        # quality is declared (so validated) before the budgets.
+        if value is not None and info.data.get("quality") not in (None, "auto"):
+            raise ValueError("an error budget chooses the setting: use quality 'auto' (or leave"
+                             " quality out), not a tier")
+        return value
 
 
 class RenderRequest(RenderFields):

@@ -18,7 +18,7 @@ from opaline.model.microfacet import (  # noqa: F401 (re-exported: the reference
     log1p_ratio,
     mdf_ashikhmin,
 )
-from opaline.model.spectrum import rgb_weights, rotation_at, sample_wavelengths
+from opaline.model.spectrum import CENTRE, rgb_weights, rotation_at, sample_wavelengths
 
 TWO_PI = 2.0 * np.pi
 
@@ -35,19 +35,25 @@ def mdf_multipeak(hx, hy, hz, mu_f, alpha, beta):
     return 0.5 * np.maximum(hz, 0.0) * (np.cos(TWO_PI * mu_f * r) + 1.0)
 
 
-def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint):
-    """Eq. 4 with the cosine box-filtered over a phase footprint (docs/design.md §4.2).
+def sinc_half(footprint):
+    """sin(Δ/2)/(Δ/2): the mean of cos over a phase interval of width Δ, per unit cos."""
+    half = 0.5 * np.asarray(footprint, dtype=np.float64)
+    safe = np.where(half > 1e-4, half, 1.0)
+    return np.where(half > 1e-4, np.sin(half) / safe, 1.0 - half * half / 6.0)
 
-    The mean of cos(x) over [x - Δ/2, x + Δ/2] is cos(x)·sinc(Δ/2), so the
-    bands fade to their average where a pixel spans more than a period.
+
+def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint, footprint_y=0.0):
+    """Eq. 4 with the cosine box-filtered over the pixel (docs/design.md §4.2).
+
+    ``footprint`` and ``footprint_y`` are how far the phase moves (radians) across the
+    sample's box along the screen's x and y. Over a box the phase is x0 + a·u + b·v with
+    u, v uniform in [-½, ½], and the mean of cos over it is cos(x0)·sinc(a/2)·sinc(b/2): a
+    product of two sincs, not one sinc of |a| + |b| (which blurs where both are large).
     """
     r = np.sqrt(alpha * hx * hx + beta * hy * hy)
     x = TWO_PI * mu_f * r
-    half = 0.5 * np.asarray(footprint, dtype=np.float64)
-    sinc = np.where(
-        half > 1e-4, np.sin(half) / np.where(half > 1e-4, half, 1.0), 1.0 - half * half / 6.0
-    )
-    return 0.5 * np.maximum(hz, 0.0) * (np.cos(x) * sinc + 1.0)
+    band = np.cos(x) * sinc_half(np.abs(footprint)) * sinc_half(np.abs(footprint_y))
+    return 0.5 * np.maximum(hz, 0.0) * (band + 1.0)
 
 
 def mdf(material, hx, hy, hz):
@@ -57,12 +63,14 @@ def mdf(material, hx, hy, hz):
     return mdf_multipeak(hx, hy, hz, material.mu_f, material.alpha, material.beta)
 
 
-def mdf_rgb(material, hx, hy, hz, wavelengths=0):
+def mdf_rgb(material, hx, hy, hz, wavelengths=0, shift=CENTRE):
     """D for R, G, B: the MDF at half vectors rotated by 0, θ1, θ2 (eq. 2), or,
-    with ``wavelengths`` > 0, per wavelength and integrated to linear sRGB."""
+    with ``wavelengths`` > 0, per wavelength (at ``shift`` through each bin) and integrated
+    to linear sRGB."""
     if wavelengths > 0:
-        thetas = rotation_at(sample_wavelengths(wavelengths), material.theta1, material.theta2)
-        weights = rgb_weights(wavelengths)
+        lam = sample_wavelengths(wavelengths, shift)
+        thetas = rotation_at(lam, material.theta1, material.theta2)
+        weights = rgb_weights(wavelengths, shift)
         total = 0.0
         for theta, weight in zip(thetas, weights, strict=True):
             rx, ry = rotate_half(hx, hy, theta)

@@ -34,9 +34,11 @@ MDF_PATH = "/v1/mdf"
 IMMUTABLE = "public, max-age=31536000, immutable"
 # Fixed order: the scene, then the tier (it sets the defaults of samples, wavelengths, aa),
 # then every other field as the request model declares it.
-# The mesh fields follow the preset: they are part of the scene, and not of the Job.
-ORDER = ("preset", *MESH_FIELDS, "quality",
-         *(n for n in RenderRequest.model_fields if n not in ("preset", "quality", *MESH_FIELDS)))
+# Fields of the request that the Job does not keep: the mesh (part of the scene) and
+# quality=auto's error budget (the Job keeps what it picked). They follow the preset.
+REQUEST_ONLY = (*MESH_FIELDS, "max_flip", "max_delta_e")
+ORDER = ("preset", *REQUEST_ONLY, "quality",
+         *(n for n in RenderRequest.model_fields if n not in ("preset", "quality", *REQUEST_ONLY)))
 
 
 REV = Field(None, pattern="^[0-9a-f]{32}$",
@@ -80,14 +82,14 @@ def canonical_fields(job: Job, preset: Preset,
     base = resolve(RenderRequest(preset=name), preset)
     if name != RenderRequest.model_fields["preset"].default:
         fields["preset"] = name
-    for field in MESH_FIELDS:
+    for field in REQUEST_ONLY:
         value = getattr(request, field, None)
         if value is not None:
             fields[field] = tuple(value) if isinstance(value, list) else value
     if job.quality != base.quality:
         fields["quality"] = job.quality
         base = resolve(RenderRequest(preset=name, quality=job.quality), preset)
-    for name in ORDER[2 + len(MESH_FIELDS):]:
+    for name in ORDER[2 + len(REQUEST_ONLY):]:
         value = _field(job, name)
         if value != _field(base, name):
             fields[name] = value

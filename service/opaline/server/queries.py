@@ -49,7 +49,7 @@ class MdfQuery(MaterialFields):
     # As RenderFields.wavelengths: bounds for the schema, the exact rule in the validator.
     wavelengths: int = Field(
         0, json_schema_extra=wavelengths_schema,
-        description="0 = the paper's RGB rotations, else 3 … 128 wavelengths (CIE 1931).")
+        description="0 = the paper's RGB rotations, else 4 … 128 wavelengths (CIE 1931).")
 
     _albedo = field_validator("albedo", mode="before")(_comma_list)
     _wavelengths = field_validator("wavelengths")(wavelengths_ok)

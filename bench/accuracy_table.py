@@ -1,0 +1,63 @@
+"""The table quality=auto reads (service/opaline/model/quality_table.json), from the grid.
+
+Per preset: the points every material variant was measured at, with the preset's own
+time for each, and per variant its difficulty (model/auto.py) and errors. Stamped with
+the hashes of the shader sources and of each preset, so a test can tell when the table
+no longer describes what the package renders.
+"""
+
+from __future__ import annotations
+
+import json
+
+
+def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
+    from opaline.model.auto import difficulty, preset_digest
+    from opaline.model.params import Material
+    from opaline.model.presets import get_preset
+    from opaline.resources import sources_digest
+
+    presets = {}
+    for preset in dict.fromkeys(r["preset"] for r in rows):
+        variants = list(dict.fromkeys(r["variant"] for r in rows if r["preset"] == preset))
+        keys = None
+        for v in variants:
+            found = {(r["samples"], r["wavelengths"], r["aa"])
+                     for r in rows if r["preset"] == preset and r["variant"] == v}
+            keys = found if keys is None else keys & found
+        base = {(r["samples"], r["wavelengths"], r["aa"]): r
+                for r in rows if r["preset"] == preset and r["variant"] == "base"}
+        points = sorted(keys, key=lambda k: (base[k]["ms"], k))  # ties in a fixed order
+        materials = []
+        for v in variants:
+            found = {(r["samples"], r["wavelengths"], r["aa"]): r
+                     for r in rows if r["preset"] == preset and r["variant"] == v}
+            fact = next(f for f in facts if f["preset"] == preset and f["variant"] == v)
+            made = Material(**fact["material"])
+            materials.append({"variant": v,
+                              "difficulty": difficulty(made, info["size"], info["size"], 1.0),
+                              "theta": [fact["material"]["theta1"], fact["material"]["theta2"]],
+                              "flip": [round(found[k]["flip"], 5) for k in points],
+                              "de2000_p95": [round(found[k]["de2000_p95"], 4) for k in points]})
+        presets[preset] = {
+            "digest": preset_digest(get_preset(preset)),
+            "points": [{"samples": k[0], "wavelengths": k[1], "aa": k[2],
+                        "ms": round(base[k]["ms"], 2)} for k in points],
+            "materials": materials,
+        }
+    table = {"command": "python bench/accuracy.py --write-table", "date": info["date"],
+             "size": info["size"], "shaders": sources_digest(), "machine": info["cpu"],
+             "presets": presets}
+    return (compact(table) + "\n").encode()
+
+
+def compact(value, indent: str = "") -> str:
+    """JSON with one line per point or error list: small, and diffs read point by point."""
+    if isinstance(value, dict) and any(isinstance(v, (dict, list)) for v in value.values()):
+        inner = indent + " "
+        items = [f"{inner}{json.dumps(k)}: {compact(v, inner)}" for k, v in value.items()]
+        return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+    if isinstance(value, list) and value and isinstance(value[0], dict):
+        inner = indent + " "
+        return "[\n" + ",\n".join(inner + compact(v, inner) for v in value) + "\n" + indent + "]"
+    return json.dumps(value)
