@@ -108,7 +108,7 @@ class Bench:
         size = size or self.size
         request = RenderRequest(preset=preset.name, width=size, height=size,
                                 samples=setting.samples, wavelengths=setting.wavelengths,
-                                aa=setting.aa, format="png")
+                                aa=setting.aa, format="png16")  # float display values
         return resolve(request, preset)
 
     def timed(self, preset, setting: Setting, repeats: int | None,

@@ -1,6 +1,8 @@
 //! defines: TONEMAP_REINHARD TONEMAP_ACES TRANSPARENT
 // Averages the accumulated samples and encodes for display: exposure, tone map,
 // sRGB; composited over the background unless the output keeps its alpha.
+// Rows are written top row first (the reverse of GL's order), so the readback
+// is already in image order; an 8-bit target quantises in GL, rounding to nearest.
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
@@ -10,11 +12,12 @@ uniform sampler2D u_accum;
 uniform float u_inv_samples;
 uniform float u_exposure;
 uniform vec3 u_background;  // display-referred sRGB
+uniform int u_height;  // of the target, for the row flip
 
 out vec4 frag_color;
 
 void main() {
-    vec4 acc = texelFetch(u_accum, ivec2(gl_FragCoord.xy), 0) * u_inv_samples;
+    vec4 acc = texelFetch(u_accum, ivec2(gl_FragCoord.x, u_height - 1 - int(gl_FragCoord.y)), 0) * u_inv_samples;
     float coverage = clamp(acc.a, 0.0, 1.0);
     vec3 straight = coverage > 0.0 ? acc.rgb / coverage : vec3(0.0);
     vec3 display = srgb_encode(tonemap(straight * u_exposure));

@@ -40,6 +40,7 @@ metrics = _load_metrics()
 
 
 def render(renderer, preset: str = PRESET, size: int = SIZE, **fields) -> np.ndarray:
+    fields.setdefault("format", "png16")  # float display values, not 8-bit pixels
     request = RenderRequest(preset=preset, width=size, height=size, **fields)
     frame = renderer.render(resolve(request, get_preset(preset)))
     return frame.linear if frame.linear is not None else frame.display

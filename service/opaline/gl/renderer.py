@@ -14,7 +14,15 @@ import moderngl
 import numpy as np
 
 from opaline.gl import uniforms
-from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
+from opaline.gl.buffers import (
+    Cancelled,
+    Frame,
+    RenderBudgets,
+    SceneGPU,
+    Targets,
+    read_bytes,
+    read_float,
+)
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
 from opaline.gl.probes import Probes
@@ -95,11 +103,7 @@ class Renderer(Probes):
             vao = self._empty_vao[program.glo] = self.ctx.vertex_array(program, [])
         vao.render(moderngl.TRIANGLES, vertices=3)
 
-    @staticmethod
-    def read(fbo: moderngl.Framebuffer, size: tuple[int, int], components: int = 4) -> np.ndarray:
-        data = fbo.read(components=components, dtype="f4")
-        image = np.frombuffer(data, dtype=np.float32).reshape(size[1], size[0], components)
-        return np.ascontiguousarray(image[::-1])  # GL rows run bottom-up
+    read = staticmethod(read_float)
 
     # Scenes
 
@@ -122,8 +126,12 @@ class Renderer(Probes):
         if job.format == "npy":
             linear = self.read(fbo, size) / np.float32(len(offsets))
             return Frame(linear=linear, display=None)
-        self._resolve(job, preset, source, targets, len(offsets))
-        return Frame(linear=None, display=self.read(targets.display_fbo, size))
+        if job.format == "png16":
+            self._resolve(job, preset, source, targets.display_fbo, len(offsets))
+            return Frame(linear=None, display=read_float(targets.display_fbo, size, flipped=True))
+        self._resolve(job, preset, source, targets.display8_fbo, len(offsets))
+        return Frame(linear=None, display=None, pixels=read_bytes(
+            targets.display8_fbo, size, 4 if job.transparent else 3))
 
     def surface_defines(self, job: Job, preset: Preset) -> dict[str, int | bool]:
         defines = uniforms.material_defines(job.material, job.wavelengths, job.aa)
@@ -201,7 +209,8 @@ class Renderer(Probes):
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
 
     def _resolve(
-        self, job: Job, preset: Preset, source: moderngl.Texture, targets: Targets, count: int
+        self, job: Job, preset: Preset, source: moderngl.Texture, target: moderngl.Framebuffer,
+        count: int,
     ) -> None:
         defines = {
             "TONEMAP_REINHARD": job.tonemap == "reinhard",
@@ -209,7 +218,7 @@ class Renderer(Probes):
             "TRANSPARENT": job.transparent,
         }
         program = self.programs.get("resolve.glsl", defines)
-        targets.display_fbo.use()
+        target.use()
         source.use(location=0)
         uniforms.apply(
             program,
@@ -218,6 +227,7 @@ class Renderer(Probes):
                 "u_inv_samples": 1.0 / count,
                 "u_exposure": job.exposure,
                 "u_background": tuple(preset.background),
+                "u_height": target.size[1],
             },
         )
         self.fullscreen(program)
