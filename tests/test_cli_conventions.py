@@ -77,7 +77,8 @@ def test_format_follows_the_extension(capsys, tmp_path):
 @pytest.mark.parametrize("argv, words", [
     (["--format", "npy", "-o", "x.png"], ["--format npy", "x.png", ".npy"]),
     (["--set", "format=npy", "-o", "x.png"], ["npy", "x.png"]),
-    (["-o", "x.jpg"], ["x.jpg", "--format"]),
+    (["-o", "x.tiff"], ["x.tiff", "--format"]),
+    (["--format", "webp", "-o", "x.jpg"], ["webp", "x.jpg"]),
     (["--format", "png16", "-o", "x.npy"], ["png16", "x.npy"]),
 ])
 def test_format_and_extension_mismatch_is_one_line(capsys, tmp_path, monkeypatch, argv, words):

@@ -95,6 +95,8 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
     tier = TIERS[fields["quality"]]
     for name, value in tier.items():
         fields.setdefault(name, value)
+    if fields["format"] == "auto":  # the HTTP service negotiates before resolving
+        fields["format"] = "png"
     material = Material(**{k: fields.pop(k) for k in MATERIAL_FIELDS if k in fields})
     return Job(
         preset=preset.name,
