@@ -25,6 +25,7 @@ from opaline.gl.buffers import (
 )
 from opaline.gl.camera import model_matrix, place_key_light, view_projection
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.detail import scene_for_size
 from opaline.gl.probes import Probes
 from opaline.gl.shaders import ProgramCache
 from opaline.lru import BudgetLRU
@@ -113,7 +114,7 @@ class Renderer(Probes):
         values) instead of the scene's own variant: the benchmark's baseline.
         ``should_stop`` is asked between samples; when it says so, ``Cancelled`` is raised."""
         self.gl.make_current()
-        preset = preset or get_preset(job.preset)
+        preset = scene_for_size(preset or get_preset(job.preset), job.width, job.height)
         size = (job.width, job.height)
         targets = self.targets(size)
         offsets = sample_offsets(job.samples)
