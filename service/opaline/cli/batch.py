@@ -6,17 +6,22 @@ import argparse
 import os
 import signal
 from pathlib import Path
-from typing import Any, get_args
+from typing import TYPE_CHECKING, Any, get_args
 
 from pydantic import ValidationError
 
-from opaline.batch.report import github_annotations, junit_xml
-from opaline.batch.run import NothingToRender, Options, _raise_interrupt, _signals, run_batch
 from opaline.cli.args import CliError, add_common, parse_size, write_output
 from opaline.model.params import ImageFormat, Quality, RenderRequest, describe_errors
 
+if TYPE_CHECKING:
+    from opaline.batch.run import Options
+
 
 def cmd_batch(args: argparse.Namespace) -> None:
+    # Imported here: `opaline render` builds this parser too and must not pay for batch.
+    from opaline.batch.report import github_annotations, junit_xml
+    from opaline.batch.run import NothingToRender, _raise_interrupt, _signals, run_batch
+
     options = options_from_args(args)
     report = report_path(args.report)
     with _signals(_raise_interrupt, signal.SIGTERM):  # SIGTERM stops a batch as Ctrl-C does
@@ -49,6 +54,8 @@ def report_path(report: list[str] | None) -> Path | None:
 
 
 def options_from_args(args: argparse.Namespace) -> Options:
+    from opaline.batch.run import Options
+
     """The batch's options, every override and limit checked before any input is read."""
     overrides = overrides_from_args(args)
     if args.server and not args.server.startswith(("http://", "https://")):
