@@ -57,6 +57,9 @@ uniform vec3 u_ambient;
 #endif
 #ifdef NORMAL_MAP
 uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
+// log2 of the sample target's scale over the image (1 when drawn at 2×): the map is
+// filtered over an image pixel's footprint however finely the pixel is sampled.
+uniform float u_lod_bias;
 #endif
 
 out vec4 frag_color;
@@ -78,7 +81,7 @@ void main() {
     }
     vec3 t = tangent_field();
 #ifdef NORMAL_MAP
-    vec3 mapped = texture(u_normal_map, v_uv).xyz;
+    vec3 mapped = texture(u_normal_map, v_uv, u_lod_bias).xyz;
     // A zero normal in the map keeps the geometric one.
     if (dot(mapped, mapped) > 1e-12) {
         n = shading_frame(n, t) * normalize(mapped);

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from opaline.gl import uniforms
+from opaline.gl import passes, uniforms
 from opaline.gl.buffers import (
     Cancelled,
     Frame,
@@ -31,7 +31,6 @@ from opaline.gl.shaders import ProgramCache
 from opaline.lru import BudgetLRU
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job
-from opaline.model.sampling import sample_offsets
 
 log = logging.getLogger(__name__)
 NORMAL_MAP_UNIT = 1
@@ -116,21 +115,22 @@ class Renderer(Probes):
         self.gl.make_current()
         preset = scene_for_size(preset or get_preset(job.preset), job.width, job.height)
         size = (job.width, job.height)
-        targets = self.targets(size)
-        offsets = sample_offsets(job.samples)
-        self._draw_samples(job, preset, targets, offsets, all_features, should_stop)
-        # One sample is left in the sample target; more are summed in the accumulation target.
-        if len(offsets) == 1:
-            fbo, source = targets.sample_fbo, targets.sample_tex
+        samples = passes.plan(job.samples, size)
+        drawn = self.targets(samples.target_size(size))
+        self._draw_samples(job, preset, drawn, samples, all_features, should_stop)
+        # One pass is left in the sample target; more are summed in the accumulation target.
+        if samples.passes == 1:
+            fbo, source = drawn.sample_fbo, drawn.sample_tex
         else:
-            fbo, source = targets.accum_fbo, targets.accum_tex
+            fbo, source = drawn.accum_fbo, drawn.accum_tex
         if job.format == "npy":
-            linear = self.read(fbo, size) / np.float32(len(offsets))
-            return Frame(linear=linear, display=None)
+            linear = passes.downsample(self.read(fbo, drawn.size), samples.factor)
+            return Frame(linear=linear / np.float32(samples.samples), display=None)
+        targets = self.targets(size)
         if job.format == "png16":
-            self._resolve(job, preset, source, targets.display_fbo, len(offsets))
+            self._resolve(job, preset, source, targets.display_fbo, samples)
             return Frame(linear=None, display=read_float(targets.display_fbo, size, flipped=True))
-        self._resolve(job, preset, source, targets.display8_fbo, len(offsets))
+        self._resolve(job, preset, source, targets.display8_fbo, samples)
         return Frame(linear=None, display=None, pixels=read_bytes(
             targets.display8_fbo, size, 4 if job.transparent else 3))
 
@@ -141,15 +141,9 @@ class Renderer(Probes):
         defines["LIGHT_COUNT"] = len(preset.lights)
         return defines
 
-    def _draw_samples(
-        self,
-        job: Job,
-        preset: Preset,
-        targets: Targets,
-        offsets: np.ndarray,
-        all_features: bool = False,
-        should_stop: Callable[[], bool] | None = None,
-    ) -> None:
+    def _draw_samples(self, job: Job, preset: Preset, targets: Targets,
+                      samples: passes.SamplePlan, all_features: bool = False,
+                      should_stop: Callable[[], bool] | None = None) -> None:
         ctx = self.ctx
         defines = self.surface_defines(job, preset)
         scene = self.scene(preset)
@@ -176,15 +170,17 @@ class Renderer(Probes):
                 ],
                 "u_light_irradiance": [tuple(light.irradiance) for light in lights],
                 "u_ambient": tuple(preset.ambient),
-                "u_aa_scale": 1.0 / np.sqrt(len(offsets)),
+                "u_aa_scale": samples.aa_scale,
             }
         )
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
+            values["u_lod_bias"] = float(np.log2(samples.factor))
             # Bound once: the accumulate pass between samples binds unit 0 only.
             normal_map.use(location=NORMAL_MAP_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
+        offsets = samples.offsets
         multi = len(offsets) > 1
         if multi:
             accumulate = self.programs.get("accumulate.glsl")
@@ -198,7 +194,9 @@ class Renderer(Probes):
             targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
-            program["u_jitter"].value = (2.0 * dx / width, 2.0 * dy / height)
+            # Offsets are in image pixels; the target may be `factor` times larger.
+            program["u_jitter"].value = (2.0 * samples.factor * dx / width,
+                                         2.0 * samples.factor * dy / height)
             vao.render(moderngl.TRIANGLES)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
@@ -209,14 +207,13 @@ class Renderer(Probes):
                 self.fullscreen(accumulate)
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
 
-    def _resolve(
-        self, job: Job, preset: Preset, source: moderngl.Texture, target: moderngl.Framebuffer,
-        count: int,
-    ) -> None:
+    def _resolve(self, job: Job, preset: Preset, source: moderngl.Texture,
+                 target: moderngl.Framebuffer, samples: passes.SamplePlan) -> None:
         defines = {
             "TONEMAP_REINHARD": job.tonemap == "reinhard",
             "TONEMAP_ACES": job.tonemap == "aces",
             "TRANSPARENT": job.transparent,
+            "DOWNSAMPLE_2X": samples.factor == 2,
         }
         program = self.programs.get("resolve.glsl", defines)
         target.use()
@@ -225,7 +222,7 @@ class Renderer(Probes):
             program,
             {
                 "u_accum": 0,
-                "u_inv_samples": 1.0 / count,
+                "u_inv_samples": 1.0 / samples.samples,
                 "u_exposure": job.exposure,
                 "u_background": tuple(preset.background),
                 "u_height": target.size[1],
