@@ -28,14 +28,15 @@ def photo(alpha: bool, seed: int = 0) -> np.ndarray:
     return encode.quantise(image, 8)
 
 
-@pytest.mark.parametrize("fmt,mime,tolerance", [
-    ("webp-lossless", "WEBP", 0.0), ("webp", "WEBP", 4.0), ("avif", "AVIF", 4.0),
-    ("jpeg", "JPEG", 3.0)])
-@pytest.mark.parametrize("alpha", [False, True])
+ROUND_TRIPS = [("webp-lossless", "WEBP", 0.0), ("webp", "WEBP", 4.0), ("avif", "AVIF", 4.0),
+               ("jpeg", "JPEG", 3.0)]
+
+
+@pytest.mark.parametrize("fmt,mime,tolerance,alpha",
+                         [(*case, alpha) for case in ROUND_TRIPS for alpha in (False, True)
+                          if not (case[0] == "jpeg" and alpha)])  # JPEG has no alpha
 def test_formats_round_trip(fmt, mime, tolerance, alpha):
     """Each format decodes to the size, mode and (within its loss) the pixels written."""
-    if fmt == "jpeg" and alpha:
-        pytest.skip("JPEG has no alpha")
     pixels = photo(alpha)
     data = encode.encode_frame(type("F", (), {"pixels": pixels})(), fmt, alpha)
     image = Image.open(io.BytesIO(data))
