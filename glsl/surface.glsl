@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC DISPLAY TONEMAP_REINHARD TONEMAP_ACES
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -55,6 +55,12 @@ uniform vec3 u_light_irradiance[LIGHT_COUNT];
 #ifdef DIFFUSE
 uniform vec3 u_ambient;
 #endif
+#ifdef DISPLAY
+// One sample straight into the 8-bit target (draft): encoded here as resolve.glsl
+// would encode a single covering sample.
+#include "lib/display.glsl"
+uniform float u_exposure;
+#endif
 #ifdef NORMAL_MAP
 uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
 // log2 of the sample target's scale over the image (1 when drawn at 2×): the map is
@@ -102,6 +108,10 @@ void main() {
 #ifdef DIFFUSE
     radiance += u_ambient * u_kd * u_albedo;
 #endif
+#ifdef DISPLAY
+    frag_color = vec4(srgb_encode(tonemap(radiance * u_exposure)), 1.0);
+#else
     frag_color = vec4(radiance, 1.0);
+#endif
 }
 #endif

@@ -80,6 +80,8 @@ class Targets:
         # the readback is a quarter of the float one, with no NumPy pass after it.
         self.display8_tex = ctx.texture(size, 4)
         self.display8_fbo = ctx.framebuffer([self.display8_tex])
+        # One 8-bit sample drawn straight into the same bytes, with the depth buffer.
+        self.direct_fbo = ctx.framebuffer([self.display8_tex], self.depth)
 
     @property
     def nbytes(self) -> int:
@@ -91,6 +93,7 @@ class Targets:
             self.accum_fbo,
             self.display_fbo,
             self.display8_fbo,
+            self.direct_fbo,
             self.sample_tex,
             self.depth,
             self.accum_tex,

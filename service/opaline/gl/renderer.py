@@ -117,6 +117,12 @@ class Renderer(Probes):
         size = (job.width, job.height)
         samples = passes.plan(job.samples, size)
         drawn = self.targets(samples.target_size(size))
+        channels = 4 if job.transparent else 3
+        if samples.passes == samples.samples == 1 and job.format not in ("npy", "png16"):
+            # One 8-bit sample: drawn and encoded in one pass, no resolve (rows bottom-up).
+            self._draw_samples(job, preset, drawn, samples, all_features, should_stop, True)
+            pixels = read_bytes(drawn.direct_fbo, size, channels)[::-1]
+            return Frame(linear=None, display=None, pixels=np.ascontiguousarray(pixels))
         self._draw_samples(job, preset, drawn, samples, all_features, should_stop)
         # One pass is left in the sample target; more are summed in the accumulation target.
         if samples.passes == 1:
@@ -131,8 +137,8 @@ class Renderer(Probes):
             self._resolve(job, preset, source, targets.display_fbo, samples)
             return Frame(linear=None, display=read_float(targets.display_fbo, size, flipped=True))
         self._resolve(job, preset, source, targets.display8_fbo, samples)
-        return Frame(linear=None, display=None, pixels=read_bytes(
-            targets.display8_fbo, size, 4 if job.transparent else 3))
+        return Frame(linear=None, display=None,
+                     pixels=read_bytes(targets.display8_fbo, size, channels))
 
     def surface_defines(self, job: Job, preset: Preset) -> dict[str, int | bool]:
         defines = uniforms.material_defines(job.material, job.wavelengths, job.aa)
@@ -143,9 +149,13 @@ class Renderer(Probes):
 
     def _draw_samples(self, job: Job, preset: Preset, targets: Targets,
                       samples: passes.SamplePlan, all_features: bool = False,
-                      should_stop: Callable[[], bool] | None = None) -> None:
+                      should_stop: Callable[[], bool] | None = None,
+                      direct: bool = False) -> None:
+        """``direct``: one sample into the 8-bit target, display-encoded by the surface."""
         ctx = self.ctx
         defines = self.surface_defines(job, preset)
+        if direct:
+            defines.update(DISPLAY=True, **self.tonemap_defines(job))
         scene = self.scene(preset)
         normal_map = scene.normal_map
         if all_features:
@@ -159,20 +169,18 @@ class Renderer(Probes):
         )
         model = model_matrix(preset.rotation_deg)
         values = uniforms.material_uniforms(job.material, job.wavelengths)
-        values.update(
-            {
-                "u_model": model.astype("f4"),
-                "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
-                "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
-                "u_eye": tuple(preset.camera.eye),
-                "u_light_position": [
-                    (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights
-                ],
-                "u_light_irradiance": [tuple(light.irradiance) for light in lights],
-                "u_ambient": tuple(preset.ambient),
-                "u_aa_scale": samples.aa_scale,
-            }
-        )
+        values.update({
+            "u_model": model.astype("f4"),
+            "u_normal_matrix": np.linalg.inv(model[:3, :3]).T.astype("f4"),
+            "u_view_proj": view_projection(preset.camera, width / height).astype("f4"),
+            "u_eye": tuple(preset.camera.eye),
+            "u_light_position": [
+                (*light.position, 1.0 if light.type == "point" else 0.0) for light in lights],
+            "u_light_irradiance": [tuple(light.irradiance) for light in lights],
+            "u_ambient": tuple(preset.ambient),
+            "u_aa_scale": samples.aa_scale,
+            "u_exposure": job.exposure,
+        })
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
             values["u_lod_bias"] = float(np.log2(samples.factor))
@@ -190,8 +198,12 @@ class Renderer(Probes):
         for index, (dx, dy) in enumerate(offsets):
             if index and should_stop is not None and should_stop():
                 raise Cancelled(f"stopped after {index} of {len(offsets)} samples")
-            targets.sample_fbo.use()
-            targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            fbo = targets.direct_fbo if direct else targets.sample_fbo
+            fbo.use()
+            # Direct: the resolve's background (opaque) or nothing (transparent) is cleared to.
+            opaque = direct and not job.transparent
+            fbo.clear(*(preset.background if opaque else (0.0, 0.0, 0.0)), float(opaque),
+                      depth=1.0)
             ctx.enable(moderngl.DEPTH_TEST)
             ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
             # Offsets are in image pixels; the target may be `factor` times larger.
@@ -209,26 +221,20 @@ class Renderer(Probes):
 
     def _resolve(self, job: Job, preset: Preset, source: moderngl.Texture,
                  target: moderngl.Framebuffer, samples: passes.SamplePlan) -> None:
-        defines = {
-            "TONEMAP_REINHARD": job.tonemap == "reinhard",
-            "TONEMAP_ACES": job.tonemap == "aces",
-            "TRANSPARENT": job.transparent,
-            "DOWNSAMPLE_2X": samples.factor == 2,
-        }
+        defines = {**self.tonemap_defines(job), "TRANSPARENT": job.transparent,
+                   "DOWNSAMPLE_2X": samples.factor == 2}
         program = self.programs.get("resolve.glsl", defines)
         target.use()
         source.use(location=0)
-        uniforms.apply(
-            program,
-            {
-                "u_accum": 0,
-                "u_inv_samples": 1.0 / samples.samples,
-                "u_exposure": job.exposure,
-                "u_background": tuple(preset.background),
-                "u_height": target.size[1],
-            },
-        )
+        uniforms.apply(program, {"u_accum": 0, "u_inv_samples": 1.0 / samples.samples,
+                                 "u_exposure": job.exposure,
+                                 "u_background": tuple(preset.background),
+                                 "u_height": target.size[1]})
         self.fullscreen(program)
+
+    @staticmethod
+    def tonemap_defines(job: Job) -> dict[str, bool]:
+        return {"TONEMAP_REINHARD": job.tonemap == "reinhard", "TONEMAP_ACES": job.tonemap == "aces"}
 
     def release(self) -> None:
         self.gl.make_current()
