@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -138,6 +139,7 @@ def measure(args) -> dict:
     from opaline.model.presets import all_presets
     from opaline.server.localserver import LocalServer
 
+    load_before = os.getloadavg()[0]
     floor = Child([sys.executable, str(FLOOR), "--serve"])
     local = Child([sys.executable, __file__, "--child"])
     presets = list(all_presets())
@@ -187,13 +189,15 @@ def measure(args) -> dict:
             "hit_server_ms": median_of_rounds(hits_server),
             "throughput": {"clients": args.clients, "workers": args.workers,
                            "images_per_s": rps, "floor_images_per_s": 1.0 / floor_s},
-            "cold": cold(args.rounds), "rounds": args.rounds, "per_round": args.per_round}
+            "cold": cold(args.rounds), "rounds": args.rounds, "per_round": args.per_round,
+            "load_average": [load_before, os.getloadavg()[0]]}
 
 
 def markdown(result: dict) -> str:
     lines = [f"Floor (bare GL, 256² sphere, RGBA8 readback, PNG level 1): "
              f"{result['floor_ms']:.2f} ms, median of {result['rounds']} interleaved rounds "
-             f"of {result['per_round']}.", "",
+             f"of {result['per_round']}; 1-minute load average {result['load_average'][0]:.1f} "
+             f"before, {result['load_average'][1]:.1f} after (2 cores).", "",
              "| measure | preset | tier | ms | × floor |", "|---|---|---|---|---|"]
     for row in result["rows"]:
         kind, preset, tier = row["measure"].split()
