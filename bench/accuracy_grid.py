@@ -54,7 +54,7 @@ class Bench:
         # The grid measures counts the API refuses (1-3 wavelengths), to show why it does.
         allowed = max(wavelengths, MIN_WAVELENGTHS) if wavelengths else 0
         request = RenderRequest(preset=preset.name, width=size, height=size, samples=samples,
-                                wavelengths=allowed, aa=aa, format="png",
+                                wavelengths=allowed, aa=aa, format="png16",
                                 quality="reference", **fields)
         return dataclasses.replace(resolve(request, preset), wavelengths=wavelengths)
 

@@ -34,7 +34,7 @@ REFERENCE = 256
 def display(local: LocalRenderer, preset: str, env: str, count: int, size: int
             ) -> tuple[np.ndarray, float]:
     request = RenderRequest(preset=preset, environment=env, environment_lights=count,
-                            width=size, height=size, quality="standard")
+                            width=size, height=size, quality="standard", format="png16")
     job = local.job(request)
     local.renderer.render(job)  # compile this K's variant
     times = []

@@ -63,7 +63,7 @@ class Bench:
         from opaline.model.request import resolve
 
         size = size or self.size
-        request = RenderRequest(preset=preset.name, width=size, height=size, format="png",
+        request = RenderRequest(preset=preset.name, width=size, height=size, format="png16",
                                 transparent=transparent, **fields)
         return self.renderer.render(resolve(request, preset), preset).display
 

@@ -51,7 +51,7 @@ def main() -> None:
     def draw(preset, theta1, theta2, samples, wavelengths):
         request = RenderRequest(preset=preset, width=args.size, height=args.size,
                                 theta1=theta1, theta2=theta2, samples=samples,
-                                wavelengths=wavelengths, aa="none")
+                                wavelengths=wavelengths, aa="none", format="png16")
         return renderer.render(resolve(request, get_preset(preset))).display
 
     ref = TIERS["reference"]

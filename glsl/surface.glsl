@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING THICKNESS_MAP TRANSMISSION
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING THICKNESS_MAP TRANSMISSION DISPLAY TONEMAP_REINHARD TONEMAP_ACES
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -55,8 +55,17 @@ uniform vec3 u_light_irradiance[LIGHT_COUNT];
 #ifdef DIFFUSE
 uniform vec3 u_ambient;
 #endif
+#ifdef DISPLAY
+// One sample straight into the 8-bit target (draft): encoded here as resolve.glsl
+// would encode a single covering sample.
+#include "lib/display.glsl"
+uniform float u_exposure;
+#endif
 #ifdef NORMAL_MAP
 uniform sampler2D u_normal_map;  // tangent-space unit normals, float RGB
+// log2 of the sample target's scale over the image (1 when drawn at 2×): the map is
+// filtered over an image pixel's footprint however finely the pixel is sampled.
+uniform float u_lod_bias;
 #endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
 uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickness texture
@@ -84,7 +93,7 @@ void main() {
     }
     vec3 t = tangent_field();
 #ifdef NORMAL_MAP
-    vec3 mapped = texture(u_normal_map, v_uv).xyz;
+    vec3 mapped = texture(u_normal_map, v_uv, u_lod_bias).xyz;
     // A zero normal in the map keeps the geometric one.
     if (dot(mapped, mapped) > 1e-12) {
         n = shading_frame(n, t) * normalize(mapped);
@@ -116,6 +125,10 @@ void main() {
     vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm());
     radiance += u_backdrop * through * through;
 #endif
+#ifdef DISPLAY
+    frag_color = vec4(srgb_encode(tonemap(radiance * u_exposure)), 1.0);
+#else
     frag_color = vec4(radiance, 1.0);
+#endif
 }
 #endif

@@ -57,8 +57,8 @@ def converged(renderer):
 
 
 def draw(renderer, preset: str, size: int, material: dict, **fields) -> np.ndarray:
-    job = resolve(RenderRequest(preset=preset, width=size, height=size, **material, **fields),
-                  get_preset(preset))
+    job = resolve(RenderRequest(preset=preset, width=size, height=size, format="png16",
+                                **material, **fields), get_preset(preset))
     return renderer.render(job, get_preset(preset)).display
 
 
@@ -124,10 +124,11 @@ def test_auto_meets_flip_005_and_is_no_slower_than_a_tier_that_does(renderer, co
     for index, material in enumerate(random_materials(preset, 5)):
         reference = converged(preset, material, size)
         jobs = {tier: resolve(RenderRequest(preset=preset, width=size, height=size,
-                                            quality=tier, **material), get_preset(preset))
+                                            quality=tier, format="png16", **material),
+                              get_preset(preset))
                 for tier in TIERS}
         request = RenderRequest(preset=preset, width=size, height=size, max_flip=TARGET,
-                                **material)
+                                format="png16", **material)
         job = resolve(request, get_preset(preset))
         got = metrics.flip(reference, renderer.render(job, get_preset(preset)).display)
         assert got <= TARGET, f"{material}: auto picked {job.auto}, FLIP {got:.4f}"

@@ -482,3 +482,18 @@ def test_container_health_check_asks_readiness():
     dockerfile = (Path(__file__).resolve().parent.parent / "Dockerfile").read_text()
     check = dockerfile[dockerfile.index("HEALTHCHECK"):]
     assert "/readyz" in check.split("\n\n")[0] and "/healthz" not in check.split("\n\n")[0]
+
+
+def test_not_ready_until_the_start_up_calibration_is_done(backend):
+    """While the start-up calibration runs, admission counts it as work ahead, so /readyz is
+    503 until it is done (then 200, and renders are admitted)."""
+    app = create_app(Settings(gl_backend=backend, warmup=False, calibrate=True))
+    with TestClient(app) as client:
+        first = client.get("/readyz")
+        assert first.status_code == 503 and first.json()["calibrated"] is False
+        end = time.monotonic() + 120
+        while client.get("/readyz").status_code != 200:
+            assert time.monotonic() < end, "never ready"
+            time.sleep(0.1)
+        assert client.get("/readyz").json()["calibrated"] is True
+        assert client.get(f"/v1/render?{SMALL}&mu_f=2.5").status_code == 200

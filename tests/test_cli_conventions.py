@@ -77,7 +77,8 @@ def test_format_follows_the_extension(capsys, tmp_path):
 @pytest.mark.parametrize("argv, words", [
     (["--format", "npy", "-o", "x.png"], ["--format npy", "x.png", ".npy"]),
     (["--set", "format=npy", "-o", "x.png"], ["npy", "x.png"]),
-    (["-o", "x.jpg"], ["x.jpg", "--format"]),
+    (["-o", "x.tiff"], ["x.tiff", "--format"]),
+    (["--format", "webp", "-o", "x.jpg"], ["webp", "x.jpg"]),
     (["--format", "png16", "-o", "x.npy"], ["png16", "x.npy"]),
 ])
 def test_format_and_extension_mismatch_is_one_line(capsys, tmp_path, monkeypatch, argv, words):
@@ -247,13 +248,13 @@ def cost_budget(monkeypatch):
 def test_cost_budget_from_the_environment(capsys, tmp_path, cost_budget):
     """OPALINE_COST_BUDGET refuses a render over it; raised, the same render goes through."""
     argv = ["render", "cd-rom", "--size", "32x32", "--quality", "draft",
-            "-o", str(tmp_path / "a.png")]  # cost 32×32×1×3 = 3072
-    cost_budget(3000)
+            "-o", str(tmp_path / "a.png")]  # cost 32×32×1×8 = 8192 (draft: 8 wavelengths)
+    cost_budget(8000)
     line = one_line_error(*run(capsys, *argv)[::2])
-    assert "over the budget of 3000" in line
-    line = one_line_error(*run(capsys, "mdf", "--size", "32", "-o", str(tmp_path / "m.png"))[::2])
-    assert "over the budget of 3000" in line
-    cost_budget(4000)
+    assert "over the budget of 8000" in line
+    line = one_line_error(*run(capsys, "mdf", "--size", "64", "-o", str(tmp_path / "m.png"))[::2])
+    assert "over the budget of 8000" in line  # 64×64×3 = 12288
+    cost_budget(9000)
     assert run(capsys, *argv)[0] == 0
     assert Image.open(tmp_path / "a.png").size == (32, 32)
 

@@ -87,10 +87,12 @@ def test_transparent_film_shows_the_background_exactly(renderer):
     specular, the bubble's pixels display as the background colour itself."""
     preset = get_preset("soap-bubble")
     request = RenderRequest(preset="soap-bubble", width=32, height=32, quality="draft",
-                            film_thickness_min=0.0, film_thickness_max=0.0, ks=0.0)
+                            film_thickness_min=0.0, film_thickness_max=0.0, ks=0.0,
+                            format="png16")  # float display values
     display = renderer.render(resolve(request, preset), preset=preset).display
     assert np.abs(display[..., :3] - np.array(preset.background)).max() < 2e-3
     # And a real film tints it: not the background everywhere.
-    request = RenderRequest(preset="soap-bubble", width=32, height=32, quality="draft", ks=0.0)
+    request = RenderRequest(preset="soap-bubble", width=32, height=32, quality="draft", ks=0.0,
+                            format="png16")
     tinted = renderer.render(resolve(request, preset), preset=preset).display
     assert np.abs(tinted[..., :3] - np.array(preset.background)).max() > 0.02

@@ -120,7 +120,7 @@ def test_cost_budget_comes_from_the_environment(on_thread, cost_budget):
     """OPALINE_COST_BUDGET bounds the Python API as it bounds the HTTP service."""
     from opaline.model.request import CostError
 
-    small = {**DISC, "width": 32, "height": 32}  # 32×32×1 sample×3 = 3072
+    small = {**DISC, "width": 32, "height": 32, "wavelengths": 0}  # 32×32×1 sample×3 = 3072
     cost_budget(3000)
     with pytest.raises(CostError, match="over the budget of 3000"):
         on_thread(api_python.render, small)
@@ -134,7 +134,7 @@ def test_plain_render_prints_no_third_party_warning():
     code = ("import sys; sys.modules['matplotlib'] = None\n"  # as on a plain install
             "from opaline import render\n"
             "render({'preset': 'cd-rom', 'width': 16, 'height': 16, 'quality': 'draft', "
-            "'wavelengths': 3})\n")
+            "'wavelengths': 4})\n")
     result = subprocess.run([sys.executable, "-W", "default", "-c", code], cwd=ROOT,
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr

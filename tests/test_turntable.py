@@ -66,7 +66,7 @@ def test_cli_turntable(tmp_path, capsys):
 @pytest.mark.gl
 def test_http_turntable_with_progress(backend):
     settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
-                        cost_budget=64 * 64 * 1 * 3 * 8)
+                        cost_budget=64 * 64 * 1 * 8 * 8)  # 8 draft frames (8 wavelengths)
     with TestClient(create_app(settings)) as client:
         over = client.post("/v1/turntables", json={"preset": "sphere", "frames": 9,
                                                    "width": 64, "height": 64, "quality": "draft"})

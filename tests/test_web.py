@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import importlib.util
 import shlex
 import subprocess
 import time
@@ -20,6 +21,11 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-sync"]
 WAIT_MS = 15_000  # the longest any one step may take in the browser
 START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up render
+
+_spec = importlib.util.spec_from_file_location("opaline_bench_web_drag",
+                                               ROOT / "bench" / "web_drag.py")
+web_drag = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(web_drag)
 
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(),
                                 reason=f"{CHROMIUM} is missing (Debian's chromium package)")
@@ -311,3 +317,21 @@ def test_page_works_with_keys_and_signing_on(browser):
         pytest.fail(str(exc))
     assert outside == [] and violations == []
     assert not any(key in url for url in urls)
+
+
+def test_dragging_shows_drafts_one_at_a_time_then_the_chosen_tier(page):
+    """While the light is dragged the preview shows draft renders (format=auto, at the
+    displayed size × devicePixelRatio) as they come, never more than one in flight; on
+    release it shows the chosen tier. The rate is printed (bench/web_drag.py measures it)."""
+    open_page(page, "?preset=sphere&quality=high")
+    page.evaluate(web_drag.PREVIEW_256)
+    seen = web_drag.drag_preview(page, 1.5, lambda: settle(page))
+    print(f"live preview: {seen['frames'] / seen['seconds']:.1f} updates/s")
+    assert seen["max"] == 1, f"{seen['max']} renders were in flight at once"
+    drafts = [u for u in seen["urls"] if "quality=draft" in u]
+    assert seen["frames"] >= 3 and len(drafts) >= seen["frames"]
+    size = page.evaluate("Math.round(document.querySelector('#preview')"
+                         ".getBoundingClientRect().width * devicePixelRatio)")
+    assert all("format=auto" in u and f"width={size}&" in u for u in drafts)
+    final = page.get_attribute("#preview", "data-url")
+    assert "quality=high" in final and "light_azimuth=" in final

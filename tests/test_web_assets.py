@@ -7,7 +7,16 @@ import pytest
 
 from mesh_helpers import mesh_bytes
 from opaline.output.animation import decode
-from test_web import CHROMIUM, browser, open_page, page, server, settle, shown_bytes  # noqa: F401
+from test_web import (  # noqa: F401
+    CHROMIUM,
+    browser,
+    open_page,
+    page,
+    server,
+    settle,
+    shown_bytes,
+    wait_until,
+)
 
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason=f"{CHROMIUM} is missing")
 
@@ -18,8 +27,8 @@ def test_mesh_upload_environment_orbit_and_downloads(page, tmp_path):  # noqa: F
     path = tmp_path / "torus.glb"
     path.write_bytes(mesh_bytes("glb"))
     page.set_input_files("#mesh-file", str(path))
-    page.wait_for_function("document.querySelector('#mesh-status').textContent"
-                           ".includes('triangles')")
+    wait_until(page, "() => document.querySelector('#mesh-status').textContent"
+                     ".includes('triangles')")
     settle(page)
     assert "2304 triangles" in page.text_content("#mesh-status")
     torus = shown_bytes(page)

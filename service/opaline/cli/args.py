@@ -27,7 +27,8 @@ from opaline.settings import BACKENDS
 TUPLE_FIELDS = {"albedo", "tangent_axis"}
 MATERIAL_SUFFIXES = (".toml", ".json")
 # What an extension may hold: the first is what the extension alone means.
-FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",)}
+FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",), ".webp": ("webp", "webp-lossless"),
+                     ".avif": ("avif",), ".jpg": ("jpeg",), ".jpeg": ("jpeg",)}
 STDOUT = "-"
 
 
@@ -116,7 +117,7 @@ def output_format(output: str, wanted: str | None, own: str | None = None,
         return own if own in allowed else "png"
     if not fits:
         raise CliError(f"-o {output}: cannot tell the format from the extension: "
-                       "use .png or .npy, or give --format")
+                       "use .png, .npy, .webp, .avif or .jpg, or give --format")
     return own if own in fits and own in allowed else fits[0]
 
 

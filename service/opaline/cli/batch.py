@@ -6,7 +6,7 @@ import argparse
 import os
 import signal
 from pathlib import Path
-from typing import Any, get_args
+from typing import TYPE_CHECKING, Any, get_args
 
 from pydantic import ValidationError
 
@@ -16,8 +16,13 @@ from opaline.batch.shard import ShardError, parse_shard
 from opaline.cli.args import CliError, add_common, parse_size, write_output
 from opaline.model.params import ImageFormat, Quality, RenderRequest, describe_errors
 
+if TYPE_CHECKING:
+    from opaline.batch.run import Options
+
 
 def cmd_batch(args: argparse.Namespace) -> None:
+    # Imported here: `opaline render` builds this parser too and must not pay for batch.
+
     options = options_from_args(args)
     report = report_path(args.report)
     with _signals(_raise_interrupt, signal.SIGTERM):  # SIGTERM stops a batch as Ctrl-C does
@@ -50,6 +55,8 @@ def report_path(report: list[str] | None) -> Path | None:
 
 
 def options_from_args(args: argparse.Namespace) -> Options:
+    from opaline.batch.run import Options
+
     """The batch's options, every override and limit checked before any input is read."""
     overrides = overrides_from_args(args)
     if args.server and not args.server.startswith(("http://", "https://")):

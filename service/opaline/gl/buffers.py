@@ -17,7 +17,9 @@ from opaline.gl import physical
 from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset, build_assets, build_thickness
 
-TARGET_BYTES_PER_PIXEL = 3 * 16 + 4  # three RGBA float32 textures and a 32-bit depth buffer
+# Three RGBA float32 textures (sample, accumulation, float display), an RGBA8 display
+# texture and a 32-bit depth buffer.
+TARGET_BYTES_PER_PIXEL = 3 * 16 + 4 + 4
 
 
 class Cancelled(Exception):
@@ -40,10 +42,28 @@ class RenderBudgets:
 
 @dataclass
 class Frame:
-    """A finished render. ``linear``: premultiplied linear RGBA; ``display``: sRGB RGBA in [0, 1]."""
+    """A finished render, top row first. ``linear``: premultiplied linear RGBA float32;
+    ``display``: sRGB RGBA float32 in [0, 1] (for 16-bit output); ``pixels``: sRGB
+    uint8, RGB or RGBA (for every 8-bit format). Exactly one is set."""
 
     linear: np.ndarray | None
     display: np.ndarray | None
+    pixels: np.ndarray | None = None
+
+
+def read_float(fbo: moderngl.Framebuffer, size: tuple[int, int], components: int = 4,
+               flipped: bool = False) -> np.ndarray:
+    """Float pixels, top row first. ``flipped``: the resolve pass already wrote them top
+    row first (GL rows otherwise run bottom-up)."""
+    data = fbo.read(components=components, dtype="f4")
+    image = np.frombuffer(data, dtype=np.float32).reshape(size[1], size[0], components)
+    return image.copy() if flipped else np.ascontiguousarray(image[::-1])
+
+
+def read_bytes(fbo: moderngl.Framebuffer, size: tuple[int, int], components: int) -> np.ndarray:
+    """The resolved 8-bit image as it lies in memory (the resolve wrote it top row first)."""
+    data = fbo.read(components=components, alignment=1)
+    return np.frombuffer(data, dtype=np.uint8).reshape(size[1], size[0], components)
 
 
 class Targets:
@@ -58,6 +78,12 @@ class Targets:
         self.accum_fbo = ctx.framebuffer([self.accum_tex])
         self.display_tex = ctx.texture(size, 4, dtype="f4")
         self.display_fbo = ctx.framebuffer([self.display_tex])
+        # 8-bit output resolves straight to bytes: GL quantises (round to nearest) and
+        # the readback is a quarter of the float one, with no NumPy pass after it.
+        self.display8_tex = ctx.texture(size, 4)
+        self.display8_fbo = ctx.framebuffer([self.display8_tex])
+        # One 8-bit sample drawn straight into the same bytes, with the depth buffer.
+        self.direct_fbo = ctx.framebuffer([self.display8_tex], self.depth)
 
     @property
     def nbytes(self) -> int:
@@ -68,10 +94,13 @@ class Targets:
             self.sample_fbo,
             self.accum_fbo,
             self.display_fbo,
+            self.display8_fbo,
+            self.direct_fbo,
             self.sample_tex,
             self.depth,
             self.accum_tex,
             self.display_tex,
+            self.display8_tex,
         ):
             obj.release()
 

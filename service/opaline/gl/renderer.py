@@ -13,9 +13,17 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from opaline.gl import physical, uniforms
+from opaline.gl import passes, physical, uniforms
 from opaline.gl.background import Backgrounds
-from opaline.gl.buffers import Cancelled, Frame, RenderBudgets, SceneGPU, Targets
+from opaline.gl.buffers import (
+    Cancelled,
+    Frame,
+    RenderBudgets,
+    SceneGPU,
+    Targets,
+    read_bytes,
+    read_float,
+)
 from opaline.gl.camera import (
     fit_matrix,
     model_matrix,
@@ -23,20 +31,23 @@ from opaline.gl.camera import (
     view_projection,
 )
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.detail import scene_for_size
+from opaline.gl.kept import Kept
 from opaline.gl.lighting import light_uniforms
 from opaline.gl.probes import Probes
+from opaline.gl.resolve import Resolve
 from opaline.gl.shaders import ProgramCache
+from opaline.gl.variants import surface_defines
 from opaline.lru import BudgetLRU
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job
-from opaline.model.sampling import sample_offsets
 from opaline.model.spectrum import wavelength_shift
 
 log = logging.getLogger(__name__)
 NORMAL_MAP_UNIT = 1
 
 
-class Renderer(Probes):
+class Renderer(Kept, Probes, Resolve):
     """Draws jobs, and (through ``Probes``) MDF plots and BRDF probes, on its own headless context."""
 
     def __init__(self, backend: str | None = None, gl: GLContext | None = None,
@@ -53,44 +64,6 @@ class Renderer(Probes):
         self.programs = ProgramCache(self.ctx, budgets.max_programs, self._forget_program)
         self.backgrounds = Backgrounds(self.ctx, self.fullscreen)
 
-    # Resources
-
-    def targets(self, size: tuple[int, int]) -> Targets:
-        found = self._targets.get(size)
-        if found is None:
-            found = Targets(self.ctx, size)
-            if not self._targets.put(size, found, found.nbytes):
-                found.release()
-                raise ValueError(f"{size[0]}×{size[1]} targets exceed the renderer's "
-                                 f"budget of {self.budgets.target_bytes} bytes")
-        return found
-
-    def scene(self, preset: Preset) -> SceneGPU:
-        key = preset.scene_key()
-        found = self._scenes.get(key)
-        if found is None:
-            found = SceneGPU(self.ctx, preset)
-            if not self._scenes.put(key, found, found.nbytes):
-                found.release()
-                raise ValueError(f"scene {preset.name} exceeds the renderer's budget of "
-                                 f"{self.budgets.scene_bytes} bytes")
-        return found
-
-    def _forget_program(self, program: moderngl.Program) -> None:
-        for scene in self._scenes.values():
-            scene.drop_vao(program.glo)
-        vao = self._empty_vao.pop(program.glo, None)
-        if vao is not None:
-            vao.release()
-
-    def cache_stats(self) -> dict[str, int]:
-        """Sizes and evictions of what this renderer keeps (reported by render workers)."""
-        return {"programs": len(self.programs), "program_evictions": self.programs.evictions,
-                "scenes": len(self._scenes), "scene_bytes": self._scenes.size_bytes,
-                "scene_evictions": self._scenes.evictions, "targets": len(self._targets),
-                "target_bytes": self._targets.size_bytes,
-                "target_evictions": self._targets.evictions}
-
     def flat_normal_map(self) -> moderngl.Texture:
         """A 1×1 map of the unperturbed normal, for the all-features baseline."""
         if self._flat_normal is None:
@@ -104,11 +77,7 @@ class Renderer(Probes):
             vao = self._empty_vao[program.glo] = self.ctx.vertex_array(program, [])
         vao.render(moderngl.TRIANGLES, vertices=3)
 
-    @staticmethod
-    def read(fbo: moderngl.Framebuffer, size: tuple[int, int], components: int = 4) -> np.ndarray:
-        data = fbo.read(components=components, dtype="f4")
-        image = np.frombuffer(data, dtype=np.float32).reshape(size[1], size[0], components)
-        return np.ascontiguousarray(image[::-1])  # GL rows run bottom-up
+    read = staticmethod(read_float)
 
     # Scenes
 
@@ -118,44 +87,49 @@ class Renderer(Probes):
         values) instead of the scene's own variant: the benchmark's baseline.
         ``should_stop`` is asked between samples; when it says so, ``Cancelled`` is raised."""
         self.gl.make_current()
-        preset = preset or get_preset(job.preset)
+        preset = scene_for_size(preset or get_preset(job.preset), job.width, job.height)
         size = (job.width, job.height)
-        targets = self.targets(size)
-        offsets = sample_offsets(job.samples)
-        self._draw_samples(job, preset, targets, offsets, all_features, should_stop)
-        # One sample is left in the sample target; more are summed in the accumulation target.
-        if len(offsets) == 1:
-            fbo, source = targets.sample_fbo, targets.sample_tex
+        # Spectral supersamples each integrate at their own wavelengths (one pass each), and
+        # an environment background is drawn per pass: those keep one sample a pass.
+        per_pass = job.wavelengths > 0 or bool(job.environment_background)
+        samples = passes.plan(job.samples, size, grid=not per_pass)
+        drawn = self.targets(samples.target_size(size))
+        channels = 4 if job.transparent else 3
+        if (samples.passes == samples.samples == 1 and job.format not in ("npy", "png16")
+                and not job.environment_background):
+            # One 8-bit sample: drawn and encoded in one pass, no resolve (rows bottom-up).
+            self._draw_samples(job, preset, drawn, samples, all_features, should_stop, True)
+            pixels = read_bytes(drawn.direct_fbo, size, channels)[::-1]
+            return Frame(linear=None, display=None, pixels=np.ascontiguousarray(pixels))
+        self._draw_samples(job, preset, drawn, samples, all_features, should_stop)
+        # One pass is left in the sample target; more are summed in the accumulation target.
+        if samples.passes == 1:
+            fbo, source = drawn.sample_fbo, drawn.sample_tex
         else:
-            fbo, source = targets.accum_fbo, targets.accum_tex
+            fbo, source = drawn.accum_fbo, drawn.accum_tex
         if job.format == "npy":
-            linear = self.read(fbo, size) / np.float32(len(offsets))
-            return Frame(linear=linear, display=None)
-        self._resolve(job, preset, source, targets, len(offsets))
-        return Frame(linear=None, display=self.read(targets.display_fbo, size))
+            linear = passes.downsample(self.read(fbo, drawn.size), samples.factor)
+            return Frame(linear=linear / np.float32(samples.samples), display=None)
+        targets = self.targets(size)
+        if job.format == "png16":
+            self._resolve(job, preset, source, targets.display_fbo, samples)
+            return Frame(linear=None, display=read_float(targets.display_fbo, size, flipped=True))
+        self._resolve(job, preset, source, targets.display8_fbo, samples)
+        return Frame(linear=None, display=None,
+                     pixels=read_bytes(targets.display8_fbo, size, channels))
 
     def surface_defines(self, job: Job, preset: Preset) -> dict[str, int | bool]:
-        defines = uniforms.material_defines(job.material, job.wavelengths, job.aa)
-        defines["NORMAL_MAP"] = preset.normal_map is not None
-        defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
-        defines["LIGHT_COUNT"] = len(preset.lights)
-        if physical.uses_thickness_map(job.material, preset):
-            defines["THICKNESS_MAP"] = True
-        if physical.uses_transmission(job.material, preset):
-            defines["TRANSMISSION"] = True
-        return defines
+        return surface_defines(job, preset)
 
-    def _draw_samples(
-        self,
-        job: Job,
-        preset: Preset,
-        targets: Targets,
-        offsets: np.ndarray,
-        all_features: bool = False,
-        should_stop: Callable[[], bool] | None = None,
-    ) -> None:
+    def _draw_samples(self, job: Job, preset: Preset, targets: Targets,
+                      samples: passes.SamplePlan, all_features: bool = False,
+                      should_stop: Callable[[], bool] | None = None,
+                      direct: bool = False) -> None:
+        """``direct``: one sample into the 8-bit target, display-encoded by the surface."""
         ctx = self.ctx
         defines = self.surface_defines(job, preset)
+        if direct:
+            defines.update(DISPLAY=True, **self.tonemap_defines(job))
         scene = self.scene(preset)
         normal_map = scene.normal_map
         if all_features:
@@ -176,19 +150,19 @@ class Renderer(Probes):
         normal_matrix = np.linalg.inv(model[:3, :3]).T
         normal_matrix /= abs(np.linalg.det(normal_matrix)) ** (1.0 / 3.0)  # unit normals stay ~unit
         values = uniforms.material_uniforms(job.material, job.wavelengths)
-        values.update(
-            {
-                "u_model": model.astype("f4"),
-                "u_normal_matrix": normal_matrix.astype("f4"),
-                "u_view_proj": view_proj.astype("f4"),
-                "u_eye": tuple(camera.eye),
-                **lights,
-                "u_ambient": tuple(preset.ambient),
-                "u_aa_scale": 1.0 / np.sqrt(len(offsets)),
-            }
-        )
+        values.update({
+            "u_model": model.astype("f4"),
+            "u_normal_matrix": normal_matrix.astype("f4"),
+            "u_view_proj": view_proj.astype("f4"),
+            "u_eye": tuple(camera.eye),
+            **lights,
+            "u_ambient": tuple(preset.ambient),
+            "u_aa_scale": samples.aa_scale,
+            "u_exposure": job.exposure,
+        })
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
+            values["u_lod_bias"] = float(np.log2(samples.factor))
             # Bound once: the accumulate pass between samples binds unit 0 only.
             normal_map.use(location=NORMAL_MAP_UNIT)
         if defines.get("TRANSMISSION"):
@@ -199,6 +173,7 @@ class Renderer(Probes):
             scene.thickness_map.use(location=physical.THICKNESS_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
+        offsets = samples.offsets
         multi = len(offsets) > 1
         if multi:
             accumulate = self.programs.get("accumulate.glsl")
@@ -213,9 +188,14 @@ class Renderer(Probes):
                 shift = wavelength_shift(index, len(offsets))
                 uniforms.apply(program, uniforms.spectral_uniforms(job.material, job.wavelengths,
                                                                    shift))
-            targets.sample_fbo.use()
-            targets.sample_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            jitter = (2.0 * dx / width, 2.0 * dy / height)
+            fbo = targets.direct_fbo if direct else targets.sample_fbo
+            fbo.use()
+            # Direct: the resolve's background (opaque) or nothing (transparent) is cleared to.
+            opaque = direct and not job.transparent
+            fbo.clear(*(preset.background if opaque else (0.0, 0.0, 0.0)), float(opaque),
+                      depth=1.0)
+            # Offsets are in image pixels; the target may be `factor` times larger.
+            jitter = (2.0 * samples.factor * dx / width, 2.0 * samples.factor * dy / height)
             if background is not None:
                 background(jitter)
             ctx.enable(moderngl.DEPTH_TEST)
@@ -230,24 +210,6 @@ class Renderer(Probes):
                 targets.sample_tex.use(location=0)
                 self.fullscreen(accumulate)
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-
-    def _resolve(
-        self, job: Job, preset: Preset, source: moderngl.Texture, targets: Targets, count: int
-    ) -> None:
-        defines = {
-            "TONEMAP_REINHARD": job.tonemap == "reinhard",
-            "TONEMAP_ACES": job.tonemap == "aces",
-            "TRANSPARENT": job.transparent,
-        }
-        program = self.programs.get("resolve.glsl", defines)
-        targets.display_fbo.use()
-        source.use(location=0)
-        uniforms.apply(
-            program,
-            {"u_accum": 0, "u_inv_samples": 1.0 / count, "u_exposure": job.exposure,
-             "u_background": tuple(preset.background)},
-        )
-        self.fullscreen(program)
 
     def release(self) -> None:
         self.gl.make_current()

@@ -123,7 +123,7 @@ def pick(preset_name: str, material: Material, width: int, height: int, exposure
          max_flip: float | None, max_delta_e: float | None, table: dict | None = None) -> Pick:
     """The fastest measured setting meeting the targets on the measured materials that stand
     for ``material`` (judged_on; the point-wise worst among them), or the fallback tier."""
-    from opaline.model.request import TIERS
+    from opaline.model.tiers import TIERS
 
     table = table or load_table()
     fallback = TIERS[FALLBACK]

@@ -29,7 +29,9 @@ from opaline.model.scene_fields import SceneFields
 TWO_PI = 2.0 * math.pi
 
 MdfName = Literal["ashikhmin", "multipeak"]
-ImageFormat = Literal["png", "png16", "npy"]
+ImageFormat = Literal["png", "png16", "npy", "webp", "webp-lossless", "avif", "jpeg"]
+# 'auto': the HTTP service picks from the Accept header (anything else draws PNG).
+RequestFormat = Literal[ImageFormat, "auto"]
 Tonemap = Literal["none", "reinhard", "aces"]
 Quality = Literal["draft", "standard", "high", "reference", "auto"]
 AntiAlias = Literal["none", "analytic"]
@@ -118,9 +120,11 @@ class RenderFields(MaterialFields, SceneFields):
 
     width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")
     height: Pixels | None = Field(None, description="Image height in pixels, 16 … 2048.")
-    format: ImageFormat | None = Field(
+    format: RequestFormat | None = Field(
         None,
-        description="'png' (8-bit sRGB), 'png16' (16-bit sRGB) or 'npy' (linear float32 RGBA).",
+        description="'png' (8-bit sRGB), 'png16' (16-bit sRGB), 'npy' (linear float32 RGBA), "
+        "'webp' (lossy), 'webp-lossless', 'avif', 'jpeg' (no alpha), or 'auto': "
+        "chosen from the Accept header over HTTP (PNG elsewhere).",
     )
     transparent: bool | None = Field(
         None, description="PNG with a transparent background instead of the preset's."

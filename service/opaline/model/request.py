@@ -16,23 +16,8 @@ from opaline.model.auto import DEFAULT_MAX_FLIP, Pick, pick
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.scene_fields import MESH_FIELDS
+from opaline.model.tiers import TIERS
 from opaline.resources import sources_digest
-
-# What each quality tier means; a request may override any field of it.
-TIERS: dict[str, dict[str, object]] = {
-    # Points on the measured fronts (docs/accuracy.md), one bundle for every preset. On most
-    # presets the RGB model's own error outweighs one sample's aliasing, so the cheap tiers
-    # buy wavelengths before samples: one sample of 8 wavelengths, band-limited, costs
-    # little more than one RGB sample and has a third to half of its error.
-    "draft": {"samples": 1, "wavelengths": 8, "aa": "analytic"},
-    # FLIP <= 0.05 on every preset at about 1.5x draft's time.
-    "standard": {"samples": 1, "wavelengths": 16, "aa": "analytic"},
-    # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
-    "high": {"samples": 8, "wavelengths": 16, "aa": "none"},
-    # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
-    # its samples and wavelengths even at theta = ±2π.
-    "reference": {"samples": 64, "wavelengths": 32, "aa": "none"},
-}
 
 BASE_DEFAULTS = {
     "width": 256,
@@ -122,6 +107,8 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
         tier = TIERS[fields["quality"]]
     for name, value in tier.items():
         fields.setdefault(name, value)
+    if fields["format"] == "auto":  # the HTTP service negotiates before resolving
+        fields["format"] = "png"
     return Job(
         preset=preset.name,
         material=material,

@@ -1,7 +1,12 @@
-"""Encoders: 8-bit and 16-bit PNG from display values, ``.npy`` from linear float.
+"""Encoders: PNG (8- and 16-bit) and ``.npy``; WebP, AVIF and JPEG in ``formats``.
 
-Quantisation rounds to nearest and PNG metadata is fixed, so the same render
-always gives the same bytes.
+8-bit images arrive as bytes resolved in GL (``Frame.pixels``); 16-bit and
+linear ones as float. PNGs are built here: fixed chunks, the "up" filter on
+every row and deflate at level 1 by ISA-L (``isal``), so the same render always
+gives the same bytes. Measured on the presets (docs/speed.md): ISA-L level 1 is
+5-7× faster than zlib level 1 and no larger; zlib level 6 was 2-8× slower
+still for 5-20 % fewer bytes. Without ``isal`` (a platform with no wheel),
+zlib level 1 writes the same images in other bytes.
 """
 
 from __future__ import annotations
@@ -11,10 +16,22 @@ import struct
 import zlib
 
 import numpy as np
-from PIL import Image
 
-MEDIA_TYPES = {"png": "image/png", "png16": "image/png", "npy": "application/x-npy"}
-EXTENSIONS = {"png": ".png", "png16": ".png", "npy": ".npy"}
+try:
+    from isal import isal_zlib as deflater
+except ImportError:  # pragma: no cover - isal is a dependency; zlib is the fallback
+    deflater = zlib
+
+from opaline.output.formats import LOSSY, encode_pillow
+
+MEDIA_TYPES = {"png": "image/png", "png16": "image/png", "npy": "application/x-npy",
+               "webp": "image/webp", "webp-lossless": "image/webp", "avif": "image/avif",
+               "jpeg": "image/jpeg"}
+EXTENSIONS = {"png": ".png", "png16": ".png", "npy": ".npy", "webp": ".webp",
+              "webp-lossless": ".webp", "avif": ".avif", "jpeg": ".jpg"}
+PNG_LEVEL = 1
+SIGNATURE = b"\x89PNG\r\n\x1a\n"
+SRGB = b"\x00"  # sRGB chunk, perceptual intent: the pixels are sRGB-encoded
 
 
 def quantise(display: np.ndarray, bits: int) -> np.ndarray:
@@ -23,36 +40,43 @@ def quantise(display: np.ndarray, bits: int) -> np.ndarray:
     return scaled.astype(np.uint8 if bits == 8 else np.uint16)
 
 
+def _chunk(kind: bytes, payload: bytes) -> bytes:
+    body = kind + payload
+    return struct.pack(">I", len(payload)) + body + struct.pack(">I", zlib.crc32(body))
+
+
+def _png(rows: bytes, width: int, height: int, depth: int, channels: int) -> bytes:
+    colour_type = 6 if channels == 4 else 2
+    header = struct.pack(">IIBBBBB", width, height, depth, colour_type, 0, 0, 0)
+    return (SIGNATURE + _chunk(b"IHDR", header) + _chunk(b"sRGB", SRGB)
+            + _chunk(b"IDAT", deflater.compress(rows, PNG_LEVEL)) + _chunk(b"IEND", b""))
+
+
+def png_pixels(pixels: np.ndarray) -> bytes:
+    """8-bit RGB or RGBA (H, W, C) uint8, every row filtered "up" (type 2)."""
+    height, width, channels = pixels.shape
+    flat = pixels.reshape(height, width * channels)
+    rows = np.empty((height, 1 + width * channels), np.uint8)
+    rows[:, 0] = 2
+    rows[0, 1:] = flat[0]  # the row above the first is zero
+    np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])  # wraps modulo 256, as PNG wants
+    return _png(rows.tobytes(), width, height, 8, channels)
+
+
 def png8(display: np.ndarray, alpha: bool) -> bytes:
-    channels = 4 if alpha else 3
-    image = Image.fromarray(quantise(display[..., :channels], 8), "RGBA" if alpha else "RGB")
-    out = io.BytesIO()
-    image.save(out, format="PNG", compress_level=6)
-    return out.getvalue()
+    """8-bit PNG from float display values (MDF plots; tests)."""
+    return png_pixels(quantise(display[..., :4 if alpha else 3], 8))
 
 
 def png16(display: np.ndarray, alpha: bool) -> bytes:
-    """16 bits per channel. Pillow cannot write 16-bit RGB, so the PNG is built with zlib."""
+    """16 bits per channel (filter type 0), from float display values."""
     channels = 4 if alpha else 3
     data = quantise(display[..., :channels], 16).astype(">u2")
     height, width = data.shape[:2]
     rows = np.concatenate(
         [np.zeros((height, 1), np.uint8), data.view(np.uint8).reshape(height, -1)], 1
     )
-
-    def chunk(kind: bytes, payload: bytes) -> bytes:
-        body = kind + payload
-        return struct.pack(">I", len(payload)) + body + struct.pack(">I", zlib.crc32(body))
-
-    colour_type = 6 if alpha else 2
-    header = struct.pack(">IIBBBBB", width, height, 16, colour_type, 0, 0, 0)
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + chunk(b"IHDR", header)
-        + chunk(b"sRGB", b"\x00")
-        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
-        + chunk(b"IEND", b"")
-    )
+    return _png(rows.tobytes(), width, height, 16, channels)
 
 
 def npy(array: np.ndarray) -> bytes:
@@ -66,7 +90,12 @@ def encode_frame(frame, fmt: str, alpha: bool = False) -> bytes:
         return npy(frame.linear)
     if fmt == "png16":
         return png16(frame.display, alpha)
-    return png8(frame.display, alpha)
+    pixels = getattr(frame, "pixels", None)
+    if pixels is None:  # a float frame (the Python API's arrays, tests)
+        pixels = quantise(frame.display[..., :4 if alpha else 3], 8)
+    if fmt == "png":
+        return png_pixels(pixels)
+    return encode_pillow(pixels, fmt)
 
 
 def mdf_display(plot: np.ndarray) -> np.ndarray:
@@ -81,3 +110,7 @@ def mdf_display(plot: np.ndarray) -> np.ndarray:
 def encode_mdf(plot: np.ndarray, fmt: str) -> bytes:
     """An MDF plot as ``npy`` (linear D) or, for any other format, a normalised 8-bit PNG."""
     return npy(plot) if fmt == "npy" else png8(mdf_display(plot), alpha=False)
+
+
+__all__ = ["EXTENSIONS", "LOSSY", "MEDIA_TYPES", "encode_frame", "encode_mdf", "npy", "png16",
+           "png8", "png_pixels", "quantise"]

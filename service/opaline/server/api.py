@@ -87,15 +87,16 @@ async def healthz() -> Health:
 
 @router.get("/readyz", tags=["operations"], summary="Readiness: a worker can render",
             description="200 while at least one render worker process has a working GL "
-                        "context, else 503: a readiness probe and the container's health "
-                        "check. Lists every worker with its pid, state, renders, memory, "
-                        "restarts and last error.",
+                        "context and the start-up warm-up and calibration are done, else 503 "
+                        "(during those seconds admission would refuse renders): a readiness "
+                        "probe and the container's health check. Lists every worker with its "
+                        "pid, state, renders, memory, restarts and last error.",
             responses={503: {"model": Readiness, "description": "No worker can render."}})
 async def readyz(svc: ServiceDep, response: Response) -> Readiness:
     workers = svc.pool.status()
     ready = next((w for w in workers if w["state"] in ("ready", "busy")), None)
-    response.status_code = 200 if ready else 503
-    return Readiness(ready=ready is not None, backend=(ready or {}).get("backend"),
+    response.status_code = 200 if svc.pool.ready else 503
+    return Readiness(ready=svc.pool.ready, backend=(ready or {}).get("backend"),
                      renderer=(ready or {}).get("renderer"), queue_depth=svc.pool.depth(),
                      calibrated=svc.pool.cost.calibrated,
                      memory_budget_bytes=memory_budget_bytes(svc.settings), workers=workers)

@@ -9,6 +9,7 @@ withdraws the job (dropped from the queue, or stopped between samples).
 
 from __future__ import annotations
 
+import time
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, Query, Request
@@ -18,6 +19,7 @@ from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
+from opaline.output.formats import HAS_ALPHA
 from opaline.scene.environments import EnvironmentMapError, check_name
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.canonical import (
@@ -31,6 +33,7 @@ from opaline.server.canonical import (
     mdf_url,
 )
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
+from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.service import Service, get_service
 from opaline.server.streaming import image_response
@@ -39,6 +42,8 @@ from opaline.workers.errors import InvalidInput
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
 ServiceDep = Annotated[Service, Depends(get_service)]
+
+
 
 
 def _over_limit(name: str, value: int, limit: int) -> str:
@@ -71,28 +76,42 @@ def client_gone(request: Request):
 
 
 async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt: str,
-                       filename: str, headers: dict[str, str] | None = None) -> Response:
+                       filename: str, started: float, headers: dict[str, str] | None = None,
+                       vary: bool = False) -> Response:
     """The image under ``key``: 304, from the cache, or rendered by a worker."""
     headers = dict(headers or {})
+    if vary:
+        headers["Vary"] = "Accept"
     if request.method == "GET":
         headers.setdefault("Cache-Control", f"public, max-age={svc.settings.cache_max_age_s}")
         tag = svc.cache.tag(key)
         if tag is not None and matches(request.headers.get("if-none-match"), tag):
+            headers["Server-Timing"] = server_timing(started, "revalidated")
             return Response(status_code=304, headers={**headers, "ETag": tag})
     data = svc.cache.get(key)
+    render_s = None
     if data is not None:
         svc.metrics.cache_hits.inc()
     else:
         svc.metrics.cache_misses.inc()
+        begun = time.perf_counter()
         data = await svc.pool.render(key, task, timeout=svc.wait_s, gone=client_gone(request))
+        render_s = time.perf_counter() - begun
     headers["ETag"] = svc.cache.tag(key) or etag(data)
     headers["Content-Disposition"] = f'inline; filename="{filename}{EXTENSIONS[fmt]}"'
+    headers["Server-Timing"] = server_timing(started, "hit" if render_s is None else "miss",
+                                             render_s)
     return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
-async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
+async def answer_render(svc: Service, request: Request, params: RenderRequest,
+                        started: float) -> Response:
     """Every answer names the image's canonical GET URL in Content-Location; only that URL
-    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade)."""
+    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade).
+    ``format=auto`` is negotiated from Accept first; the answer then varies by Accept."""
+    auto = params.format == "auto"
+    if auto:
+        params = negotiated(params, request)
     preset = get_preset(params.preset)
     if params.mesh is not None:
         preset = request.app.state.meshes.preset(params, preset,
@@ -103,6 +122,9 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
         except EnvironmentMapError as exc:
             raise InvalidInput(str(exc)) from None
     job, query = canonical_job(resolve(params, preset), preset, params)
+    if job.transparent and job.format not in HAS_ALPHA:
+        raise LimitError([f"format={job.format} has no alpha channel: transparent=true needs "
+                          "png, png16, webp, webp-lossless or avif"])
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
     url = canonical_url(query, key)
@@ -110,7 +132,7 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
     if request.method == "GET" and is_canonical(request.url.query, url):
         headers["Cache-Control"] = IMMUTABLE
     return await answer_image(svc, request, key, ImageTask(job, preset), job.format, preset.name,
-                              headers)
+                              started, headers, vary=auto)
 
 
 IMAGE = {"schema": {"type": "string", "format": "binary"}}
@@ -125,9 +147,11 @@ LOCATION = {"Content-Location": {"description": "The image's canonical GET URL: 
 CONDITIONAL: dict[int | str, dict[str, Any]] = {
     304: {"description": "Not modified: If-None-Match matched the ETag."}}
 RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
-    200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
-          "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
-          "headers": {**ETAG, **LOCATION}},
+    200: {"description": "The image: PNG (8- or 16-bit sRGB), WebP, AVIF, JPEG or .npy (linear "
+                         "float32 RGBA); format=auto picks from Accept and sends Vary: Accept.",
+          "content": {t: IMAGE for t in ("image/png", "image/webp", "image/avif", "image/jpeg",
+                                         "application/x-npy")}, "headers": {**ETAG, **LOCATION}},
+    406: {"model": Problem, "description": "format=auto and Accept allows no image type made."},
     404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
     413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
@@ -149,21 +173,23 @@ BODY = {"requestBody": {"required": True, "content": {
 
 @router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
              summary="Render a preset with material overrides (JSON body)", openapi_extra=BODY)
-async def render_post(request: Request, svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, parse_body(await request.body(), RenderRequest))
+async def render_post(started: Started, request: Request, svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, parse_body(await request.body(), RenderRequest),
+                               started)
 
 
 @router.get("/v1/render", tags=["render"], response_class=Response,
             responses={**RENDER_RESPONSES, **CONDITIONAL},
             summary="Render a preset with material overrides (query string, for <img src>)")
-async def render_get(params: Annotated[CanonicalQuery, Query()], request: Request,
-                     svc: ServiceDep) -> Response:
-    return await answer_render(svc, request, params.request())
+async def render_get(started: Started, params: Annotated[CanonicalQuery, Query()],
+                     request: Request, svc: ServiceDep) -> Response:
+    return await answer_render(svc, request, params.request(), started)
 
 
 @router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
             summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
-async def mdf_get(query: Annotated[CanonicalMdfQuery, Query()], request: Request,
+async def mdf_get(started: Started, query: Annotated[CanonicalMdfQuery, Query()],
+                  request: Request,
                   svc: ServiceDep) -> Response:
     params, canonical = canonical_plot(query.plot())
     check_mdf_limits(params, svc.settings)
@@ -174,4 +200,4 @@ async def mdf_get(query: Annotated[CanonicalMdfQuery, Query()], request: Request
     if is_canonical(request.url.query, url):
         headers["Cache-Control"] = IMMUTABLE
     task = MdfTask(material, params.size, params.format, params.wavelengths)
-    return await answer_image(svc, request, key, task, params.format, "mdf", headers)
+    return await answer_image(svc, request, key, task, params.format, "mdf", started, headers)

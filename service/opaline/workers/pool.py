@@ -17,6 +17,7 @@ import time
 import uuid
 from collections import Counter, deque
 from collections.abc import Awaitable, Callable
+from concurrent.futures import Future
 from typing import Any
 
 from opaline.workers.admission import CostModel, admit
@@ -55,6 +56,7 @@ class WorkerPool:
         self.cost = CostModel()
         self.counters: Counter[str] = Counter()
         self.stopping = True
+        self.warming: list[Future] = []
         self.slots: list[Slot] = []
         self._queue: deque[Job] = deque()
         self._inflight: dict[str, Job] = {}
@@ -80,8 +82,10 @@ class WorkerPool:
         tasks = [self.warmup, CalibrateTask() if self.calibrate else None]
         with self._cond:  # first in the queue, never expiring, counted in the backlog
             for task in filter(None, tasks):
-                self._enqueue(Job(next(self._ids), uuid.uuid4().hex, task, task.label,
-                                  math.inf, self.cost.predict(*task.units())))
+                job = Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf,
+                          self.cost.predict(*task.units()))
+                self._enqueue(job)
+                self.warming.append(job.future)
 
     def stop(self, timeout: float = 10.0) -> None:
         """Refuse new jobs, fail the queued ones, and let each worker release its context."""
@@ -172,8 +176,6 @@ class WorkerPool:
                 return  # running: its slot sees waiters == 0 and stops it between samples
         self.fail(job, Cancelled("every client waiting for it left"))
 
-    # Called by the slots
-
     def take(self, slot: Slot) -> Job | None:
         with self._cond:
             if not self._queue:
@@ -228,14 +230,13 @@ class WorkerPool:
                 self.counters["expired"] += 1
                 self.fail(job, DeadlineExceeded(f"queued longer than {self.deadline_s:g} s"))
 
-    # State
-
     def depth(self) -> int:
         return len(self._queue)
 
     @property
     def ready(self) -> bool:
-        return any(slot.ready for slot in self.slots)
+        """A worker can render now, and the start-up work (warm-up, calibration) is done."""
+        return any(slot.ready for slot in self.slots) and all(f.done() for f in self.warming)
 
     @property
     def identity(self) -> str:

@@ -51,7 +51,8 @@
   const LIGHT = { azimuth: 'light_azimuth', elevation: 'light_elevation' };
   // Where a drag starts while the preset's key light direction is not known.
   const LIGHT_FALLBACK = { light_azimuth: 0, light_elevation: 45 };
-  const EXTENSIONS = { png: '.png', png16: '.png', npy: '.npy' };
+  const EXTENSIONS = { png: '.png', png16: '.png', npy: '.npy', webp: '.webp',
+    'webp-lossless': '.webp', avif: '.avif', jpeg: '.jpg' };
   const BOOLEANS = new Map([['true', true], ['1', true], ['false', false], ['0', false]]);
   // With access control on, the service wants an API key; the page keeps the one the user
   // types for this tab only (sessionStorage) and sends it as a header, never in a URL.
@@ -523,10 +524,73 @@
   let seq = 0;
   let inflight = null;
 
+  // While a hand drags (the light pad or a slider), the preview shows draft renders as
+  // fast as the service returns them: at most one in flight, and when it lands the
+  // newest state is asked for next (the states passed over meanwhile are never sent).
+  // They are drawn at the preview's displayed size × devicePixelRatio and negotiated
+  // (format=auto: WebP in browsers that take it). When the hand stops, the draft in
+  // flight is cancelled and the chosen request is rendered as usual.
+  const live = { active: false, inflight: null, pending: false, frames: 0 };
+
+  function liveQuery() {
+    const query = renderQuery(true);
+    const job = state.info.resolved;
+    const w = valueOf('width') ?? job.width;
+    const hgt = valueOf('height') ?? job.height;
+    const shown = $('#preview').getBoundingClientRect().width || w;
+    const width = clamp(Math.round(shown * (window.devicePixelRatio || 1)), 16, 2048);
+    const height = clamp(Math.round((width * hgt) / w), 16, 2048);
+    for (const name of TIER_FIELDS) query.delete(name);
+    query.set('quality', 'draft');
+    query.set('format', 'auto');
+    query.set('width', String(width));
+    query.set('height', String(height));
+    return query;
+  }
+
+  async function liveRender() {
+    if (live.inflight) {
+      live.pending = true;
+      return;
+    }
+    if (!state.info || state.invalid.size) return;
+    live.pending = false;
+    live.inflight = new AbortController();
+    const result = await loadImage($('#preview'), `${API.render}?${liveQuery()}`,
+      live.inflight.signal);
+    live.inflight = null;
+    if (result.ok && !result.kept) {
+      live.frames += 1;
+      document.body.dataset.liveFrames = String(live.frames);
+    }
+    if (live.active && live.pending) liveRender();
+  }
+
+  function startLive() {
+    if (live.active) return;
+    live.active = true;
+    clearTimeout(timer);
+    if (inflight) inflight.abort();  // the chosen render is asked for again at the end
+    document.body.classList.remove('loading');
+  }
+
+  function endLive() {
+    if (!live.active) return;
+    live.active = false;
+    live.pending = false;
+    if (live.inflight) live.inflight.abort();
+    live.inflight = null;
+    schedule(0);
+  }
+
   function schedule(delay = DEBOUNCE_MS) {
     document.body.dataset.busy = 'true';
     writeOutputs();
     clearTimeout(timer);
+    if (live.active) {
+      liveRender();
+      return;
+    }
     timer = setTimeout(update, delay);
   }
 
@@ -867,6 +931,11 @@
     $('#copy-button').addEventListener('click', copySelected);
     $('#controls').addEventListener('submit', (event) => event.preventDefault());
     setupLightPad();
+    // A drag is live from the press on the light pad or a slider to the release.
+    document.addEventListener('pointerdown', (event) => {
+      if (event.button === 0 && event.target.closest('#stage, input[type="range"]')) startLive();
+    }, true);
+    for (const kind of ['pointerup', 'pointercancel']) document.addEventListener(kind, endLive, true);
 
     if (!(await choosePreset(wanted, overridesFromUrl(query))) && wanted !== names[0]) {
       state.presetError = $('#err-preset').textContent;
