@@ -9,13 +9,12 @@ benchmark measured (no timed tests).
 
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from bench_metrics import metrics
 from opaline.model import auto
 from opaline.model.params import RenderRequest
 from opaline.model.presets import all_presets, get_preset
@@ -30,15 +29,6 @@ PRESETS = sorted(all_presets())
 TWO_PI = 2.0 * np.pi
 
 
-def _load_metrics():
-    path = Path(__file__).resolve().parents[1] / "bench" / "metrics.py"
-    spec = importlib.util.spec_from_file_location("opaline_bench_metrics", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-metrics = _load_metrics()
 
 
 @pytest.fixture(scope="module")

@@ -9,12 +9,10 @@ The metrics are the benchmark's (bench/metrics.py).
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from bench_metrics import metrics
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
@@ -28,15 +26,6 @@ MANY_SAMPLES = 256  # brute-force reference in the image plane (wavelengths 0, a
 MANY_WAVELENGTHS = 128  # spectral reference, at the same samples as the renders it judges
 
 
-def _load_metrics():
-    path = Path(__file__).resolve().parents[1] / "bench" / "metrics.py"
-    spec = importlib.util.spec_from_file_location("opaline_bench_metrics", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-metrics = _load_metrics()
 
 
 def render(renderer, preset: str = PRESET, size: int = SIZE, **fields) -> np.ndarray:
