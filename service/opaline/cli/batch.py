@@ -10,9 +10,6 @@ from typing import TYPE_CHECKING, Any, get_args
 
 from pydantic import ValidationError
 
-from opaline.batch.report import github_annotations, junit_xml
-from opaline.batch.run import NothingToRender, Options, _raise_interrupt, _signals, run_batch
-from opaline.batch.shard import ShardError, parse_shard
 from opaline.cli.args import CliError, add_common, parse_size, write_output
 from opaline.model.params import ImageFormat, Quality, RenderRequest, describe_errors
 
@@ -22,6 +19,8 @@ if TYPE_CHECKING:
 
 def cmd_batch(args: argparse.Namespace) -> None:
     # Imported here: `opaline render` builds this parser too and must not pay for batch.
+    from opaline.batch.report import github_annotations, junit_xml
+    from opaline.batch.run import NothingToRender, _raise_interrupt, _signals, run_batch
 
     options = options_from_args(args)
     report = report_path(args.report)
@@ -56,6 +55,7 @@ def report_path(report: list[str] | None) -> Path | None:
 
 def options_from_args(args: argparse.Namespace) -> Options:
     from opaline.batch.run import Options
+    from opaline.batch.shard import ShardError, parse_shard
 
     """The batch's options, every override and limit checked before any input is read."""
     overrides = overrides_from_args(args)

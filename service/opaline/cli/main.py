@@ -25,14 +25,13 @@ from opaline.model.meshes import MeshFileMissing
 from opaline.model.params import RenderRequest
 from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
-from opaline.output.gltf import GltfImportError
 from opaline.resources import PRESETS_ENV, presets_dir
 from opaline.scene.environments import EnvironmentMapError
 from opaline.scene.meshfile import MeshError
 
 log = logging.getLogger("opaline.cli")
 USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
-                EnvironmentMapError, MeshFileMissing, GltfImportError)
+                EnvironmentMapError, MeshFileMissing)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
 USES_PRESETS = ("render", "presets", "batch", "gallery", "serve", "turntable", "export",
                 "import")
@@ -168,9 +167,13 @@ def run(args: argparse.Namespace) -> int:
         where = exc.filename if exc.filename is not None else ""
         return fail(f"{where}: {exc.strerror}" if where and exc.strerror else exc, 1)
     except Exception as exc:  # context or shader failures: one line, non-zero
+        # Imported here, not at the top: `opaline render` must not pay for pygltflib.
         from opaline.gl.context import ContextError
         from opaline.gl.shaders import ShaderError
+        from opaline.output.gltf import GltfImportError
 
+        if isinstance(exc, GltfImportError):
+            return fail(exc, 2)
         if isinstance(exc, (ContextError, ShaderError)):
             return fail(exc, 1)
         raise

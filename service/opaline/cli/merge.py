@@ -12,9 +12,6 @@ import argparse
 import json
 from pathlib import Path
 
-from opaline.batch.report import junit_xml
-from opaline.batch.shard import ShardError, merge_summaries, tasks_from_summary
-from opaline.batch.sheet import write_contact_sheet
 from opaline.cli.args import CliError, write_output
 from opaline.cli.batch import report_path
 from opaline.output.files import write_atomic
@@ -31,6 +28,11 @@ def read_summary(path: str) -> dict:
 
 
 def cmd_merge(args: argparse.Namespace) -> None:
+    # Imported here: every command builds this parser; only batch-merge needs these.
+    from opaline.batch.report import junit_xml
+    from opaline.batch.shard import ShardError, merge_summaries, tasks_from_summary
+    from opaline.batch.sheet import write_contact_sheet
+
     out = Path(args.out)
     report = report_path(args.report)
     try:
