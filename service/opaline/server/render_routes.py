@@ -15,7 +15,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
-from opaline.model.presets import get_preset
+from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.scene.environments import EnvironmentMapError, check_name
@@ -30,12 +30,11 @@ from opaline.server.canonical import (
     is_canonical,
     mdf_url,
 )
-from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
+from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, UnknownEnvironment
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.service import Service, get_service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
-from opaline.workers.errors import InvalidInput
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -90,9 +89,10 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
     return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
-async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
-    """Every answer names the image's canonical GET URL in Content-Location; only that URL
-    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade)."""
+def scene_preset(request: Request, svc: Service, params: RenderRequest) -> Preset:
+    """The preset a request draws (its mesh's, if it names one), after checking that its
+    environment exists: names are the built-ins plus the files of a folder, which the schema
+    cannot list, so an unknown one is 404 ``unknown_environment`` (as presets are)."""
     preset = get_preset(params.preset)
     if params.mesh is not None:
         preset = request.app.state.meshes.preset(params, preset,
@@ -101,7 +101,14 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest) -
         try:
             check_name(params.environment, svc.settings.environments_dir)
         except EnvironmentMapError as exc:
-            raise InvalidInput(str(exc)) from None
+            raise UnknownEnvironment(str(exc)) from None
+    return preset
+
+
+async def answer_render(svc: Service, request: Request, params: RenderRequest) -> Response:
+    """Every answer names the image's canonical GET URL in Content-Location; only that URL
+    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade)."""
+    preset = scene_preset(request, svc, params)
     job, query = canonical_job(resolve(params, preset), preset, params)
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
@@ -128,9 +135,10 @@ RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The image: PNG (8- or 16-bit sRGB) or .npy (linear float32 RGBA).",
           "content": {"image/png": IMAGE, "application/x-npy": IMAGE},
           "headers": {**ETAG, **LOCATION}},
-    404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
-    413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
+    404: {"model": Problem, "description": "error 'unknown_preset' (the message lists the valid "
+                                           "ones), 'unknown_mesh' or 'unknown_environment' (not "
+                                           "built in, not a file of the environments folder)."},
 }
 MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",
