@@ -1,5 +1,5 @@
-"""Exports over HTTP: the material as GLSL (GET, computed here: no mesh, no GL) and the mesh
-with its material as .glb (POST, built by a worker, which alone touches meshes)."""
+"""Exports over HTTP: the material as GLSL (GET) and the mesh with its material as .glb
+(POST), both written by a worker: only workers touch meshes and load GL modules."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ from typing import Annotated
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
-from opaline.gl.export_glsl import export_glsl
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset
 from opaline.model.request import Job, content_key, resolve
@@ -16,7 +15,7 @@ from opaline.server.errors import ERROR_RESPONSES
 from opaline.server.queries import RenderQuery, parse_body
 from opaline.server.render_routes import BODY, RENDER_RESPONSES, scene_preset
 from opaline.server.service import Service, get_service
-from opaline.workers.export_task import GlbTask
+from opaline.workers.export_task import GlbTask, GlslTask
 
 ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
@@ -33,7 +32,10 @@ def _resolved(request: Request, svc: Service, params: RenderRequest) -> tuple[Pr
 async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Request,
                           svc: ServiceDep) -> Response:
     _, job = _resolved(request, svc, params)
-    return Response(export_glsl(job.material, job.wavelengths), media_type="text/plain",
+    key = content_key({"glsl": job.canonical()})
+    data = await svc.pool.render(key, GlslTask(job.material, job.wavelengths),
+                                 timeout=svc.wait_s)
+    return Response(data, media_type="text/plain",
                     headers={"Content-Disposition": 'attachment; filename="opaline.glsl"'})
 
 
