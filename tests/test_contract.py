@@ -7,6 +7,7 @@ from fastapi.testclient import TestClient
 
 from opaline.model.params import RenderRequest, wavelengths_ok
 from opaline.server.api import create_app
+from opaline.server.methods import REPEATABLE, repeated
 from opaline.server.queries import MdfQuery, RenderQuery
 from opaline.settings import Settings
 
@@ -83,6 +84,16 @@ def test_repeated_scalar_parameter_is_422_naming_it(client, query):
 def test_albedo_may_repeat(client):
     response = client.get(f"/v1/render?{SMALL}&albedo=0.1&albedo=0.2&albedo=0.3")
     assert response.status_code == 200
+
+
+def test_every_tuple_field_may_repeat_or_be_comma_separated():
+    """The repeatable names come from the models: a new tuple field needs no change."""
+    assert {"albedo", "tangent_axis"} <= REPEATABLE
+    assert "mu_f" not in REPEATABLE
+    assert not repeated(b"tangent_axis=1&tangent_axis=0&tangent_axis=0&albedo=0.1")
+    spelled = (RenderQuery(tangent_axis="1,0,0").tangent_axis,
+               RenderQuery(tangent_axis=["1", "0", "0"]).tangent_axis)
+    assert spelled == ((1.0, 0.0, 0.0), (1.0, 0.0, 0.0))
 
 
 # Methods

@@ -62,7 +62,7 @@ def test_folder_meshes_by_name(client):
 def test_broken_uploads_get_422_and_the_service_stays_ready(client, name):
     answer = client.post("/v1/meshes", content=broken_files()[name])
     assert answer.status_code == 422, answer.text
-    assert len(answer.json()["detail"][0]) > 10
+    assert answer.json()["error"] == "invalid_mesh" and len(answer.json()["detail"][0]) > 10
     assert client.get("/readyz").status_code == 200
 
 
@@ -73,7 +73,7 @@ def test_over_limit_uploads(client):
     many = client.post("/v1/meshes", content=_many_triangles())
     assert many.status_code == 422 and "limit of 5000" in many.json()["detail"][0]
     empty = client.post("/v1/meshes", content=b"")
-    assert empty.status_code == 422
+    assert empty.status_code == 422 and empty.json()["error"] == "invalid_mesh"
     assert client.get("/readyz").status_code == 200
     assert client.get(f"/v1/render?preset=sphere&{SMALL}").status_code == 200
 
@@ -118,8 +118,10 @@ def test_http_process_never_imports_a_mesh_parser():
 def test_environment_over_http(client):
     lit = client.get(f"/v1/render?preset=sphere&environment=sky&environment_lights=8&{SMALL}")
     assert lit.status_code == 200 and lit.content.startswith(b"\x89PNG")
-    unknown = client.get(f"/v1/render?preset=sphere&environment=../x.hdr&{SMALL}")
-    assert unknown.status_code == 422 and "not known" in unknown.json()["detail"][0]
+    for path in ("/v1/render", "/v1/export/glsl"):
+        unknown = client.get(f"{path}?preset=sphere&environment=../x.hdr&{SMALL}")
+        assert unknown.status_code == 404 and "not known" in unknown.json()["detail"][0]
+        assert unknown.json()["error"] == "unknown_environment"
 
 
 @pytest.mark.gl
@@ -134,3 +136,6 @@ def test_exports_over_http(client):
 
     assert import_glb(glb.content)["alpha"] == 3.0
     assert client.post("/v1/export/glb", json={"mesh": "f" * 32}).status_code == 404
+    # parsed strictly, as POST /v1/render's body: a boolean is not a number
+    lax = client.post("/v1/export/glb", json={"preset": "sphere", "light_elevation": False})
+    assert lax.status_code == 422 and lax.json()["error"] == "invalid"

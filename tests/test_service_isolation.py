@@ -199,8 +199,8 @@ def test_sigkill_of_a_batch_leaves_no_process_behind(tmp_path, env):
 
 
 def test_the_http_process_never_loads_gl(backend, tmp_path):
-    """After start-up and a render, the HTTP process has not imported moderngl or glcontext:
-    only its worker processes touch GL."""
+    """After start-up, a render and a GLSL export, the HTTP process has not imported
+    moderngl or glcontext: only its worker processes touch GL."""
     script = tmp_path / "probe.py"
     script.write_text(
         "import sys\n"
@@ -212,6 +212,7 @@ def test_the_http_process_never_loads_gl(backend, tmp_path):
         "    with TestClient(app) as client:\n"
         "        assert client.get('/v1/render?width=32&height=32&quality=draft')"
         ".status_code == 200\n"
+        "        assert client.get('/v1/export/glsl?mu_f=6').status_code == 200\n"
         "    print(sorted({'moderngl', 'glcontext'} & set(sys.modules)))\n")
     result = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
                             timeout=120, env=loopback_env())

@@ -3,6 +3,7 @@ camera really turns; the CLI and HTTP paths work, report progress and respect th
 
 from __future__ import annotations
 
+import asyncio
 import time
 
 import numpy as np
@@ -16,7 +17,10 @@ from opaline.model.request import resolve
 from opaline.model.turntable import TurntableRequest, frame_jobs
 from opaline.output.animation import ANIMATION_FORMATS, decode, encode
 from opaline.server.api import create_app
+from opaline.server.service import Service
+from opaline.server.turntable_routes import Turntable, patiently
 from opaline.settings import Settings
+from opaline.workers.errors import DeadlineExceeded, Overloaded
 
 
 def test_frames_step_once_around_from_the_still_view():
@@ -66,11 +70,14 @@ def test_cli_turntable(tmp_path, capsys):
 @pytest.mark.gl
 def test_http_turntable_with_progress(backend):
     settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
-                        cost_budget=64 * 64 * 1 * 8 * 8)  # 8 draft frames (8 wavelengths)
+                        cost_budget=64 * 64 * 1 * 8 * 8,  # 8 draft frames, 8 wavelengths
+                        max_turntables=1)
     with TestClient(create_app(settings)) as client:
         over = client.post("/v1/turntables", json={"preset": "sphere", "frames": 9,
                                                    "width": 64, "height": 64, "quality": "draft"})
         assert over.status_code == 422 and "frames" in over.json()["detail"][0]
+        lax = client.post("/v1/turntables", json={"preset": "sphere", "light_elevation": False})
+        assert lax.status_code == 422 and lax.json()["error"] == "invalid"  # strict, as render
         started = client.post("/v1/turntables", json={
             "preset": "sphere", "frames": 8, "width": 64, "height": 64, "quality": "draft",
             "animation": "webp"})
@@ -87,4 +94,44 @@ def test_http_turntable_with_progress(backend):
         result = client.get(status["result"])
         assert result.status_code == 200 and result.headers["content-type"] == "image/webp"
         assert decode(result.content, "webp") == (8, (64, 64))
-        assert client.get("/v1/turntables/nope").status_code == 404
+        for path in ("/v1/turntables/nope", "/v1/turntables/nope/result"):
+            unknown = client.get(path)
+            assert unknown.status_code == 404 and unknown.json()["error"] == "unknown_turntable"
+        # one running turntable is the cap here: another is 429 busy, the same one is not
+        found = client.app.state.turntables
+        found["x"] = Turntable("x", 8, "webp")
+        busy = client.post("/v1/turntables", json={"preset": "sphere", "frames": 2,
+                                                   "width": 32, "height": 32})
+        assert busy.status_code == 429 and busy.json()["error"] == "busy", busy.text
+        assert int(busy.headers["retry-after"]) >= 1
+        rendering = client.get("/v1/turntables/x/result")
+        assert rendering.status_code == 409 and rendering.json()["error"] == "rendering"
+        found["x"].state, found["x"].failure = "failed", DeadlineExceeded("no image in 2 s")
+        failed = client.get("/v1/turntables/x/result")
+        assert failed.status_code == 503 and failed.json()["error"] == "deadline"
+
+
+class FullQueue:
+    """A pool whose queue is full for the first ``refusals`` submissions."""
+
+    def __init__(self, refusals: int) -> None:
+        self.refusals, self.calls = refusals, 0
+
+    async def render(self, key, task, timeout=None):
+        self.calls += 1
+        if self.calls <= self.refusals:
+            raise Overloaded("full", retry_after_s=0.01)
+        return b"frame"
+
+
+def test_a_frame_waits_out_a_full_queue_until_the_turntable_deadline():
+    svc = Service(Settings(), FullQueue(3), None, None)  # type: ignore[arg-type]
+
+    async def go(deadline_in: float) -> bytes:
+        return await patiently(svc, "k", None, asyncio.get_running_loop().time() + deadline_in)
+
+    assert asyncio.run(go(5.0)) == b"frame" and svc.pool.calls == 4
+    svc.pool.refusals, svc.pool.calls = 10**6, 0
+    with pytest.raises(DeadlineExceeded, match="queue stayed full"):
+        asyncio.run(go(0.05))
+    assert svc.pool.calls > 1

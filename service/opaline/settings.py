@@ -65,6 +65,11 @@ class Settings(BaseSettings):
     worker_target_mb: int = Field(
         256, ge=218, description="Bytes of framebuffers a worker keeps (LRU); at least one "
                                  "2048² set (218 MB).")
+    max_turntables: int = Field(
+        2, ge=1, le=64,
+        description="Turntables rendered at once; one more is refused with 429 and Retry-After. "
+                    "Their frames share one lane per worker, so other requests always find "
+                    "room in the queue.")
     retry_after_s: int = Field(1, ge=1, le=3600, description="Retry-After sent with a 503.")
     cache_bytes: int = Field(
         256 * 1024 * 1024, ge=0, description="Byte budget of the in-memory image cache (0: off).")

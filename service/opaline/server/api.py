@@ -25,6 +25,7 @@ from opaline.gl.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
+from opaline.model.turntable import TurntableRequest
 from opaline.server.access import Access
 from opaline.server.cache import ImageCache
 from opaline.server.connections import STATS as CONNECTION_STATS
@@ -201,7 +202,7 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.include_router(turntable_router)
     app.include_router(export_router)
     app.include_router(router)
-    document(app, RenderRequest)
+    document(app, RenderRequest, TurntableRequest)
     mount_docs(app)
     mount_web(app)
     return app

@@ -2,8 +2,9 @@
 
 Every 4xx and 5xx answers ``{"error": reason, "detail": [line, ...]}``: 422 with
 one line per problem, 400 for a body that does not parse, 404 for an unknown
-preset or path, 413 for a body over the limit, 503 with Retry-After, 500 with a
-pointer to the server log (the traceback and any shader log go only there).
+preset, mesh, environment, turntable or path, 413 for a body over the limit, 409
+for a turntable still rendering, 429 and 503 with Retry-After, 500 with a pointer
+to the server log (the traceback and any shader log go only there).
 Each answer is counted under its reason. ``install`` puts the handlers and the
 body limit on an app.
 """
@@ -25,7 +26,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.presets import UnknownPreset
 from opaline.model.request import CostError
-from opaline.server.meshstore import MeshTooLarge, UnknownMesh
+from opaline.server.meshstore import InvalidMesh, MeshTooLarge, UnknownMesh
 from opaline.server.metrics import REJECT_REASONS, Metrics
 from opaline.server.queries import Malformed, MdfQuery
 from opaline.workers.errors import (
@@ -47,6 +48,26 @@ class LimitError(ValueError):
         self.problems = problems
 
 
+class UnknownEnvironment(LookupError):
+    """An environment name that is neither built in nor a file of the environments folder."""
+
+
+class UnknownTurntable(LookupError):
+    """A turntable id this server does not know (never started, or forgotten)."""
+
+
+class StillRendering(Exception):
+    """The turntable's animation is not ready yet (409)."""
+
+
+class Busy(Exception):
+    """As many turntables as the service runs at once are running (429 with Retry-After)."""
+
+    def __init__(self, message: str, retry_after_s: float = 1.0) -> None:
+        super().__init__(message)
+        self.retry_after_s = retry_after_s
+
+
 PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
     Malformed: (400, "malformed"),
     UnknownPreset: (404, "unknown_preset"),
@@ -62,6 +83,11 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
     InvalidInput: (422, "invalid"),
     UnknownMesh: (404, "unknown_mesh"),
     MeshTooLarge: (413, "too_large"),
+    InvalidMesh: (422, "invalid_mesh"),
+    UnknownEnvironment: (404, "unknown_environment"),
+    UnknownTurntable: (404, "unknown_turntable"),
+    StillRendering: (409, "rendering"),
+    Busy: (429, "busy"),
 }
 
 
@@ -86,8 +112,8 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
                                            "JSON, or nested too deep)."},
     403: {"model": Problem, "description": "Access control is on and the request has no valid "
                                            "API key or URL signature."},
-    404: {"model": Problem, "description": "Unknown preset (the message lists the valid ones) "
-                                           "or path."},
+    404: {"model": Problem, "description": "Unknown preset (the message lists the valid ones), "
+                                           "mesh, environment or path."},
     413: {"model": Problem, "description": "Request body too large."},
     422: {"model": Problem, "description": "Invalid parameters, or over a configured limit."},
     429: {"model": Problem, "description": "Over the rate limit.", "headers": RETRY_AFTER},
@@ -138,7 +164,7 @@ async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
         return problem(status, reason, exc.problems)
     if isinstance(exc, RenderFailed):
         return problem(status, reason, f"{exc}: the details are in the server log")
-    if status == 503:
+    if status in (429, 503):
         wait = getattr(exc, "retry_after_s", state.settings.retry_after_s)
         retry = str(max(state.settings.retry_after_s, math.ceil(wait)))
         return problem(status, reason, f"{exc}; retry later", headers={"Retry-After": retry})

@@ -1,5 +1,5 @@
-"""Exports over HTTP: the material as GLSL (GET, computed here: no mesh, no GL) and the mesh
-with its material as .glb (POST, built by a worker, which alone touches meshes)."""
+"""Exports over HTTP: the material as GLSL (GET) and the mesh with its material as .glb
+(POST), both written by a worker: only workers touch meshes and load GL modules."""
 
 from __future__ import annotations
 
@@ -8,40 +8,43 @@ from typing import Annotated
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
-from opaline.gl.export_glsl import export_glsl
 from opaline.model.params import RenderRequest
-from opaline.model.presets import Preset, get_preset
+from opaline.model.presets import Preset
 from opaline.model.request import Job, content_key, resolve
 from opaline.server.errors import ERROR_RESPONSES
-from opaline.server.queries import RenderQuery
+from opaline.server.queries import RenderQuery, parse_body
+from opaline.server.render_routes import BODY, RENDER_RESPONSES, scene_preset
 from opaline.server.service import Service, get_service
-from opaline.workers.export_task import GlbTask
+from opaline.workers.export_task import GlbTask, GlslTask
 
 ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 
 def _resolved(request: Request, svc: Service, params: RenderRequest) -> tuple[Preset, Job]:
-    preset = get_preset(params.preset)
-    if params.mesh is not None:
-        preset = request.app.state.meshes.preset(params, preset, svc.settings.mesh_max_triangles)
+    preset = scene_preset(request, svc, params)
     return preset, resolve(params, preset)
 
 
 @router.get("/v1/export/glsl", tags=["export"], response_class=Response,
-            responses=ERROR_RESPONSES,
+            responses={**ERROR_RESPONSES, 404: RENDER_RESPONSES[404]},
             summary="The material as one self-contained GLSL function (opaline_radiance)")
 async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Request,
                           svc: ServiceDep) -> Response:
     _, job = _resolved(request, svc, params)
-    return Response(export_glsl(job.material, job.wavelengths), media_type="text/plain",
+    key = content_key({"glsl": job.canonical()})
+    data = await svc.pool.render(key, GlslTask(job.material, job.wavelengths),
+                                 timeout=svc.wait_s)
+    return Response(data, media_type="text/plain",
                     headers={"Content-Disposition": 'attachment; filename="opaline.glsl"'})
 
 
+# Parsed strictly, as POST /v1/render's body ({"light_elevation": false} is refused).
 @router.post("/v1/export/glb", tags=["export"], response_class=Response,
-             responses=ERROR_RESPONSES,
+             responses={**ERROR_RESPONSES, 404: RENDER_RESPONSES[404]}, openapi_extra=BODY,
              summary="The mesh with the material as glTF 2.0 binary (.glb)")
-async def export_glb_post(body: RenderRequest, request: Request, svc: ServiceDep) -> Response:
+async def export_glb_post(request: Request, svc: ServiceDep) -> Response:
+    body = parse_body(await request.body(), RenderRequest)
     preset, job = _resolved(request, svc, body)
     key = content_key({"glb": job.canonical(), "scene": preset.scene_key()})
     data = await svc.pool.render(key, GlbTask(preset, job.material, job.wavelengths),

@@ -2,10 +2,11 @@
 
 The HTTP process stores and hashes the bytes (``meshstore``); a worker parses
 and validates them (``workers.mesh_tasks``), so the answer is 201 with the
-mesh's summary, or 422 saying what is wrong with the file (which is then
-not kept), or 413 for a file over ``OPALINE_MESH_MAX_BYTES``. Renders name
-the id as ``mesh=<id>``; ``MeshStore.preset`` turns that into the preset the
-worker draws.
+mesh's summary, or 422 ``invalid_mesh`` saying what is wrong with the file
+(which is then not kept; the body's schema, any binary, cannot express what a
+mesh is), or 413 for a file over ``OPALINE_MESH_MAX_BYTES``. Renders name the
+id as ``mesh=<id>``; ``MeshStore.preset`` turns that into the preset the worker
+draws.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from fastapi import APIRouter, Depends, Request
 from pydantic import BaseModel, Field
 
 from opaline.server.errors import ERROR_RESPONSES, Problem
-from opaline.server.meshstore import MeshStore
+from opaline.server.meshstore import InvalidMesh, MeshStore
 from opaline.server.render_routes import client_gone
 from opaline.server.service import Service, get_service
 from opaline.workers.errors import InvalidInput
@@ -42,8 +43,11 @@ def store_of(request: Request) -> MeshStore:
 
 
 MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
-    413: {"model": Problem, "description": "The file is over the service's size limit."},
     **ERROR_RESPONSES,
+    413: {"model": Problem, "description": "The file is over the service's size limit."},
+    422: {"model": Problem, "description": "error 'invalid_mesh': the body is empty, is not a "
+                                           "glTF/GLB, OBJ, PLY or STL file, is malformed, or has "
+                                           "more triangles than the service allows."},
 }
 
 
@@ -55,8 +59,8 @@ MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
 async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     data = await request.body()
     if not data:
-        raise InvalidInput("empty body: send the mesh file (glTF/GLB, OBJ, PLY or STL) "
-                           "as the request body")
+        raise InvalidMesh("empty body: send the mesh file (glTF/GLB, OBJ, PLY or STL) "
+                          "as the request body")
     store = store_of(request)
     mesh_id = store.put(data)
     max_triangles = svc.settings.mesh_max_triangles
@@ -64,7 +68,7 @@ async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     try:
         summary = await svc.pool.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
                                         timeout=svc.wait_s, gone=client_gone(request))
-    except InvalidInput:
+    except InvalidInput as exc:
         store.discard(mesh_id)
-        raise
+        raise InvalidMesh(str(exc)) from None
     return MeshInfo(id=mesh_id, **json.loads(summary))

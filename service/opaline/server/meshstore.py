@@ -38,6 +38,11 @@ class UnknownMesh(KeyError):
                 "upload it with POST /v1/meshes and use the id it answers")
 
 
+class InvalidMesh(ValueError):
+    """The uploaded bytes are not a mesh this service reads, or one over its limits (422
+    ``invalid_mesh``: the OpenAPI schema of the body, any binary, cannot say which are)."""
+
+
 class MeshTooLarge(ValueError):
     """The upload is over ``mesh_max_bytes`` (413)."""
 

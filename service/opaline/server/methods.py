@@ -7,8 +7,9 @@ and OPTIONS with 204 and the path's Allow, read from the app's own routes.
 
 A query string may repeat a name; pydantic keeps the last value, so
 ``mu_f=2000&mu_f=1`` rendered while the other order was refused. A repeated
-scalar parameter is now a 422 naming it; only the colours (``albedo=R&albedo=G&
-albedo=B``) may repeat.
+scalar parameter is now a 422 naming it; only the tuple fields of the query models
+(``albedo=R&albedo=G&albedo=B``, ``tangent_axis`` ...) may repeat, read from the models
+so that a new tuple field repeats without a change here.
 """
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ from starlette.routing import Match, Mount
 from starlette.types import ASGIApp, Receive, Scope, Send
 
 from opaline.server.errors import problem
+from opaline.server.queries import MdfQuery, RenderQuery, tuple_fields
 
-REPEATABLE = frozenset({"albedo"})
+REPEATABLE = tuple_fields(RenderQuery) | tuple_fields(MdfQuery)
 PROBED = ("GET", "POST", "PUT", "PATCH", "DELETE")
 
 

@@ -26,7 +26,8 @@ RENDER_BUCKETS = (0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0,
 REJECT_REASONS = ("invalid", "malformed", "unknown_preset", "not_found", "method_not_allowed",
                   "cost", "too_slow", "too_large", "queue_full", "deadline", "unavailable",
                   "cancelled", "forbidden", "rate_limited", "timeout", "render_failed", "error", "limit",
-                  "unknown_mesh")
+                  "unknown_mesh", "invalid_mesh", "unknown_environment", "unknown_turntable",
+                  "rendering", "busy")
 # The worker pool's own counters, exported as they stand at scrape time.
 POOL_COUNTERS = {
     "restarts_crash": ("opaline_worker_restarts", "Worker processes replaced, by reason.",

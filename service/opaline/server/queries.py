@@ -1,13 +1,15 @@
 """The query-string forms of the request models: GET /v1/render and GET /v1/mdf.
 
-A query string has no arrays, so a colour is written ``albedo=R,G,B`` (or the
-parameter repeated three times); every other field is the request model's own.
+A query string has no arrays, so a tuple field is written comma-separated
+(``albedo=R,G,B``, ``tangent_axis=X,Y,Z``) or as the parameter repeated, one value
+each time; every other field is the request model's own.
 """
 
 from __future__ import annotations
 
 from functools import cache
-from typing import Any, Literal, TypeVar
+from types import NoneType, UnionType
+from typing import Any, Literal, TypeVar, Union, get_args, get_origin
 
 from pydantic import BaseModel, Field, field_validator
 from pydantic_core import from_json, to_json
@@ -29,13 +31,26 @@ def _comma_list(value: Any) -> Any:
     return value.split(",") if isinstance(value, str) else value
 
 
+def _is_tuple(annotation: Any) -> bool:
+    """Whether a field's type is a tuple, alone or beside None."""
+    if get_origin(annotation) in (Union, UnionType):
+        return any(_is_tuple(a) for a in get_args(annotation) if a is not NoneType)
+    return get_origin(annotation) is tuple
+
+
+def tuple_fields(model: type[BaseModel]) -> frozenset[str]:
+    """The fields a query string may give as repeated parameters (one value each)."""
+    return frozenset(name for name, f in model.model_fields.items() if _is_tuple(f.annotation))
+
+
 class RenderQuery(RenderRequest):
     """A render request in a query string."""
 
     albedo: tuple[Unit, Unit, Unit] | None = Field(
         None, description="Diffuse colour, linear RGB, each 0 … 1, written R,G,B.")
 
-    _albedo = field_validator("albedo", mode="before")(_comma_list)
+    _tuples = field_validator(*tuple_fields(RenderRequest) | {"albedo"},
+                              mode="before")(_comma_list)
 
 
 class MdfQuery(MaterialFields):

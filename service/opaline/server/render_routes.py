@@ -16,7 +16,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
-from opaline.model.presets import get_preset
+from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.output.formats import HAS_ALPHA
@@ -32,13 +32,12 @@ from opaline.server.canonical import (
     is_canonical,
     mdf_url,
 )
-from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem
+from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, UnknownEnvironment
 from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.service import Service, get_service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
-from opaline.workers.errors import InvalidInput
 from opaline.workers.tasks import ImageTask, MdfTask, Task
 
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -104,14 +103,10 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
     return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
-async def answer_render(svc: Service, request: Request, params: RenderRequest,
-                        started: float) -> Response:
-    """Every answer names the image's canonical GET URL in Content-Location; only that URL
-    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade).
-    ``format=auto`` is negotiated from Accept first; the answer then varies by Accept."""
-    auto = params.format == "auto"
-    if auto:
-        params = negotiated(params, request)
+def scene_preset(request: Request, svc: Service, params: RenderRequest) -> Preset:
+    """The preset a request draws (its mesh's, if it names one), after checking that its
+    environment exists: names are the built-ins plus the files of a folder, which the schema
+    cannot list, so an unknown one is 404 ``unknown_environment`` (as presets are)."""
     preset = get_preset(params.preset)
     if params.mesh is not None:
         preset = request.app.state.meshes.preset(params, preset,
@@ -120,7 +115,19 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest,
         try:
             check_name(params.environment, svc.settings.environments_dir)
         except EnvironmentMapError as exc:
-            raise InvalidInput(str(exc)) from None
+            raise UnknownEnvironment(str(exc)) from None
+    return preset
+
+
+async def answer_render(svc: Service, request: Request, params: RenderRequest,
+                        started: float) -> Response:
+    """Every answer names the image's canonical GET URL in Content-Location; only that URL
+    is immutable (another spelling, or a stale rev, may lead elsewhere after an upgrade).
+    ``format=auto`` is negotiated from Accept first; the answer then varies by Accept."""
+    auto = params.format == "auto"
+    if auto:
+        params = negotiated(params, request)
+    preset = scene_preset(request, svc, params)
     job, query = canonical_job(resolve(params, preset), preset, params)
     if job.transparent and job.format not in HAS_ALPHA:
         raise LimitError([f"format={job.format} has no alpha channel: transparent=true needs "
@@ -152,9 +159,11 @@ RENDER_RESPONSES: dict[int | str, dict[str, Any]] = {
           "content": {t: IMAGE for t in ("image/png", "image/webp", "image/avif", "image/jpeg",
                                          "application/x-npy")}, "headers": {**ETAG, **LOCATION}},
     406: {"model": Problem, "description": "format=auto and Accept allows no image type made."},
-    404: {"model": Problem, "description": "Unknown preset; the message lists the valid ones."},
     413: {"model": Problem, "description": "Request body too large."},
     **ERROR_RESPONSES,
+    404: {"model": Problem, "description": "error 'unknown_preset' (the message lists the valid "
+                                           "ones), 'unknown_mesh' or 'unknown_environment' (not "
+                                           "built in, not a file of the environments folder)."},
 }
 MDF_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The MDF plot: PNG (normalised, sRGB) or .npy (linear D, float32).",

@@ -2,9 +2,18 @@
 GET .../result answers the animation.
 
 Each frame is an ordinary render job (cached, deduplicated, admitted, run by
-the workers), at most one per worker at a time so a turntable never fills
-the queue that other requests need; a worker then encodes the frames. The
-cost budget covers all frames. Progress is the count of finished frames.
+the workers); a worker then encodes the frames. The cost budget covers all
+frames. Progress is the count of finished frames.
+
+Turntables must not crowd out single renders, nor fail because single renders
+filled the queue for a moment: all running turntables share one frame lane per
+worker (so they add at most one frame per worker to the work ahead), at most
+``max_turntables`` run at once (one more is 429 ``busy`` with Retry-After), and
+a frame refused as Overloaded waits and is submitted again until the
+turntable's own deadline (one render deadline per frame, plus one wait).
+Failures answer in the public shape: 404 ``unknown_turntable``, 409
+``rendering``, and a failed turntable's result answers its failure's own
+status (422 ``too_slow``, 503 ``deadline`` ...).
 """
 
 from __future__ import annotations
@@ -15,17 +24,25 @@ from dataclasses import dataclass, field
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import Response
 from pydantic import BaseModel
 
-from opaline.model.presets import get_preset
 from opaline.model.request import content_key, resolve
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
 from opaline.output.animation import EXTENSIONS, MEDIA_TYPES
-from opaline.server.errors import ERROR_RESPONSES
-from opaline.server.render_routes import check_limits
+from opaline.server.errors import (
+    ERROR_RESPONSES,
+    RETRY_AFTER,
+    Busy,
+    Problem,
+    StillRendering,
+    UnknownTurntable,
+)
+from opaline.server.queries import parse_body
+from opaline.server.render_routes import RENDER_RESPONSES, check_limits, scene_preset
 from opaline.server.service import Service, get_service
 from opaline.workers.animation_task import AnimationTask
+from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
 
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -51,6 +68,7 @@ class Turntable:
     state: str = "running"
     error: str | None = None
     data: bytes | None = None
+    failure: Exception | None = field(default=None, repr=False)
     task: Any = field(default=None, repr=False)
 
     def status(self) -> TurntableStatus:
@@ -65,44 +83,104 @@ def registry(request: Request) -> OrderedDict[str, Turntable]:
     return state.turntables
 
 
+def lanes(request: Request, workers: int) -> asyncio.Semaphore:
+    """The frame lanes every turntable shares: one per worker."""
+    state = request.app.state
+    if not hasattr(state, "turntable_lanes"):
+        state.turntable_lanes = asyncio.Semaphore(workers)
+    return state.turntable_lanes
+
+
+async def patiently(svc: Service, key: str, task: Any, deadline: float) -> bytes:
+    """A render that waits out a full queue (Overloaded) until ``deadline`` (loop time)."""
+    loop = asyncio.get_running_loop()
+    while True:
+        try:
+            return await svc.pool.render(key, task, timeout=svc.wait_s)
+        except Overloaded as exc:
+            left = deadline - loop.time()
+            if left <= 0:
+                raise DeadlineExceeded(f"the queue stayed full until the turntable's "
+                                       f"deadline ({exc})") from None
+            await asyncio.sleep(min(max(exc.retry_after_s, 0.05), left))
+
+
 async def run(svc: Service, entry: Turntable, tasks: list[tuple[str, ImageTask]],
-              fps: int) -> None:
+              fps: int, shared: asyncio.Semaphore) -> None:
     frames: list[bytes | None] = [None] * len(tasks)
-    lanes = asyncio.Semaphore(svc.settings.workers)
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + len(tasks) * svc.settings.deadline_s + svc.wait_s
 
     async def one(index: int, key: str, task: ImageTask) -> None:
-        async with lanes:
-            frames[index] = await svc.pool.render(key, task, timeout=svc.wait_s)
+        async with shared:
+            frames[index] = await patiently(svc, key, task, deadline)
             entry.done += 1
 
     try:
         await asyncio.gather(*(one(i, key, task) for i, (key, task) in enumerate(tasks)))
         encode = AnimationTask(tuple(f for f in frames if f is not None), entry.fmt, fps)
-        entry.data = await svc.pool.render(f"animation:{entry.id}", encode, timeout=svc.wait_s)
+        entry.data = await patiently(svc, f"animation:{entry.id}", encode, deadline)
         entry.state = "done"
-    except Exception as exc:  # each failure's public message; the turntable is marked failed
-        entry.state, entry.error = "failed", f"{type(exc).__name__}: {exc}"
+    except Exception as exc:  # kept: the result answers it as the public error it is
+        entry.state, entry.error, entry.failure = "failed", f"{type(exc).__name__}: {exc}", exc
 
 
-@router.post("/v1/turntables", tags=["turntables"], status_code=202, responses=ERROR_RESPONSES,
+RENDER_404 = RENDER_RESPONSES[404]
+BUSY = {"model": Problem, "headers": RETRY_AFTER,
+        "description": "error 'busy': as many turntables as the service runs at once are "
+                       "rendering; retry after Retry-After seconds."}
+UNKNOWN = {"model": Problem, "description": "error 'unknown_turntable': never started here, "
+                                            "or forgotten (the service keeps the latest 64)."}
+RESULT_RESPONSES: dict[int | str, dict[str, Any]] = {
+    200: {"description": "The animation: animated WebP, GIF or MP4.",
+          "content": {t: {"schema": {"type": "string", "format": "binary"}}
+                      for t in MEDIA_TYPES.values()}},
+    **ERROR_RESPONSES,
+    404: UNKNOWN,
+    409: {"model": Problem, "description": "error 'rendering': the frames are not all done yet; "
+                                           "GET /v1/turntables/{id} tells how far it is."},
+    422: {"model": Problem, "description": "The turntable failed: a frame is over the "
+                                           "service's limits (too_slow)."},
+    503: {"model": Problem, "headers": RETRY_AFTER,
+          "description": "The turntable failed: no image within its deadline, or no worker; "
+                         "POST it again to restart it."},
+}
+
+
+# Parsed strictly, as POST /v1/render's body ({"light_elevation": false} is refused).
+BODY = {"requestBody": {"required": True, "content": {
+    "application/json": {"schema": {"$ref": "#/components/schemas/TurntableRequest"}}}}}
+
+
+@router.post("/v1/turntables", tags=["turntables"], status_code=202, openapi_extra=BODY,
+             responses={**ERROR_RESPONSES, 404: RENDER_404, 429: BUSY},
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
-async def turntable_post(body: TurntableRequest, request: Request,
-                         svc: ServiceDep) -> TurntableStatus:
+async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
+    body = parse_body(await request.body(), TurntableRequest)
     still = body.still()
-    preset = get_preset(still.preset)
-    if still.mesh is not None:
-        preset = request.app.state.meshes.preset(still, preset, svc.settings.mesh_max_triangles)
+    preset = scene_preset(request, svc, still)
     job = resolve(still, preset)
     check_limits(job, svc.settings)
     check_turntable_cost(job, body.frames, svc.settings.cost_budget)
     jobs = frame_jobs(job, preset, body.frames)
     tasks = [(j.cache_key(preset.scene_key()), ImageTask(j, preset)) for j in jobs]
+    predicted = svc.pool.cost.predict(*tasks[0][1].units())
+    if predicted > svc.settings.deadline_s:  # every frame would be refused: say so now
+        raise TooSlow(f"each frame is predicted to take {predicted:.1f} s, over the "
+                      f"{svc.settings.deadline_s:g} s limit: lower width, height, samples or "
+                      "wavelengths (or choose a lower quality)")
     key = content_key({"frames": [k for k, _ in tasks], "fmt": body.animation, "fps": body.fps})
     found = registry(request)
     entry = found.get(key)
     if entry is None or entry.state == "failed":
+        running = sum(t.state == "running" for t in found.values())
+        if running >= svc.settings.max_turntables:
+            raise Busy(f"{running} turntables are rendering, the most this service runs at "
+                       "once; retry later", retry_after_s=svc.settings.deadline_s)
         entry = found[key] = Turntable(key, body.frames, body.animation)
-        entry.task = asyncio.create_task(run(svc, entry, tasks, body.fps))
+        found.move_to_end(key)
+        shared = lanes(request, svc.settings.workers)
+        entry.task = asyncio.create_task(run(svc, entry, tasks, body.fps, shared))
         while len(found) > KEPT:
             oldest = found.popitem(last=False)[1]
             if oldest.task is not None and oldest.state == "running":
@@ -110,28 +188,29 @@ async def turntable_post(body: TurntableRequest, request: Request,
     return entry.status()
 
 
-def _entry(request: Request, turntable_id: str) -> Turntable | None:
-    return registry(request).get(turntable_id)
+def _entry(request: Request, turntable_id: str) -> Turntable:
+    entry = registry(request).get(turntable_id)
+    if entry is None:
+        raise UnknownTurntable(f"turntable {turntable_id!r} is not known here: start it with "
+                               "POST /v1/turntables (finished ones are forgotten after 64)")
+    return entry
 
 
 @router.get("/v1/turntables/{turntable_id}", tags=["turntables"],
+            responses={**ERROR_RESPONSES, 404: UNKNOWN},
             summary="A turntable's progress: frames done of frames")
 async def turntable_get(turntable_id: str, request: Request) -> TurntableStatus:
-    entry = _entry(request, turntable_id)
-    if entry is None:
-        return JSONResponse({"detail": f"turntable {turntable_id!r} is not known"}, 404)
-    return entry.status()
+    return _entry(request, turntable_id).status()
 
 
 @router.get("/v1/turntables/{turntable_id}/result", tags=["turntables"],
-            response_class=Response, summary="The finished animation (409 while it renders)")
+            response_class=Response, responses=RESULT_RESPONSES,
+            summary="The finished animation (409 while it renders)")
 async def turntable_result(turntable_id: str, request: Request) -> Response:
     entry = _entry(request, turntable_id)
-    if entry is None:
-        return JSONResponse({"detail": f"turntable {turntable_id!r} is not known"}, 404)
+    if entry.state == "failed" and entry.failure is not None:
+        raise entry.failure  # its own public status and reason (errors.PUBLIC_ERRORS)
     if entry.state != "done" or entry.data is None:
-        detail = entry.error or f"still rendering: {entry.done} of {entry.frames} frames done"
-        return JSONResponse({"detail": detail, **entry.status().model_dump()},
-                            409 if entry.state == "running" else 500)
+        raise StillRendering(f"still rendering: {entry.done} of {entry.frames} frames done")
     headers = {"Content-Disposition": f'inline; filename="turntable{EXTENSIONS[entry.fmt]}"'}
     return Response(entry.data, media_type=MEDIA_TYPES[entry.fmt], headers=headers)

@@ -1,5 +1,7 @@
-"""Export a request's mesh and material as .glb in a worker: only workers build or load
-meshes (a user's mesh file is parsed nowhere else)."""
+"""Exports run in a worker: the mesh and material as .glb (only workers build or load
+meshes: a user's mesh file is parsed nowhere else), and the material as GLSL (its
+uniforms are written by ``opaline.gl``, which loads moderngl: the HTTP process never
+imports GL)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from opaline.output.gltf import export_glb, tangent_fields
 from opaline.workers.tasks import StopCheck
 
 EXPORT_LABEL = "export-glb"
+GLSL_LABEL = "export-glsl"
 
 
 @dataclass(frozen=True)
@@ -28,3 +31,19 @@ class GlbTask:
 
     def units(self) -> tuple[str, float, int]:
         return EXPORT_LABEL, 0.0, 0
+
+
+@dataclass(frozen=True)
+class GlslTask:
+    material: Material
+    wavelengths: int
+    label: str = GLSL_LABEL
+
+    def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
+        # imported here: this module is imported by the HTTP process, which must not load GL
+        from opaline.gl.export_glsl import export_glsl
+
+        return export_glsl(self.material, self.wavelengths).encode()
+
+    def units(self) -> tuple[str, float, int]:
+        return GLSL_LABEL, 0.0, 0
