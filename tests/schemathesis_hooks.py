@@ -17,7 +17,8 @@ import schemathesis
 from schemathesis.specs.openapi.checks import positive_data_acceptance
 
 LIMITS = {"cost", "too_slow", "limit",
-          "invalid_mesh"}  # any binary is schema-valid; only mesh files are meshes
+          "invalid_mesh",  # any binary is schema-valid; only mesh files are meshes
+          "budget_with_tier"}  # max_flip/max_delta_e exclude a named tier: a cross-field rule
 
 
 @schemathesis.check

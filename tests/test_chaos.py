@@ -48,7 +48,7 @@ def figure(capsys, text: str) -> None:
 def start(**env: str) -> LocalServer:
     base = {"OPALINE_WARMUP": "false", "OPALINE_HEADER_TIMEOUT_S": str(READ_TIMEOUT_S),
             "OPALINE_BODY_TIMEOUT_S": str(READ_TIMEOUT_S),
-            "OPALINE_WRITE_TIMEOUT_S": str(WRITE_TIMEOUT_S), "OPALINE_DEADLINE_S": "2"}
+            "OPALINE_WRITE_TIMEOUT_S": str(WRITE_TIMEOUT_S), "OPALINE_DEADLINE_S": "5"}
     return LocalServer(workers=1, env={**base, **env}, log_level="info")
 
 

@@ -31,6 +31,10 @@ VARIANTS = {
     "multipeak": (Material(), 0),
     "multipeak-spectral-diffuse-fresnel": (Material(kd=0.3, f0=0.04, mu_f=12.0), 8),
     "ashikhmin": (Material(mdf="ashikhmin", ex=300.0, ey=20.0, kd=0.1), 0),
+    # The physical sources have int uniforms (grating orders) and their own libraries.
+    "thin-film": (Material(mdf="ashikhmin", iridescence="thin-film", film_thickness_min=250.0,
+                           film_thickness_max=250.0), 16),
+    "grating-fast": (Material(mdf="ashikhmin", iridescence="grating", ex=2000.0, ey=2000.0), 0),
 }
 
 

@@ -35,6 +35,10 @@ def _literal(kind: str, value: object) -> str:
     kind = GLSL_TYPES.get(kind, kind)
     if kind == "float":
         return repr(float(value))  # repr keeps every digit of the double
+    if kind in ("int", "uint"):
+        return str(int(value))  # type: ignore[call-overload]
+    if kind == "bool":
+        return "true" if value else "false"
     parts = ", ".join(repr(float(x)) for x in value)  # type: ignore[union-attr]
     return f"{kind}({parts})"
 

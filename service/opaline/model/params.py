@@ -18,6 +18,7 @@ from pydantic import (
     ValidationInfo,
     field_validator,
 )
+from pydantic_core import PydanticCustomError
 
 from opaline.model import messages
 
@@ -179,8 +180,11 @@ class RenderFields(MaterialFields, SceneFields):
     def _budget_needs_auto(cls, value: float | None, info: ValidationInfo) -> float | None:
         # quality is declared (so validated) before the budgets.
         if value is not None and info.data.get("quality") not in (None, "auto"):
-            raise ValueError("an error budget chooses the setting: use quality 'auto' (or leave"
-                             " quality out), not a tier")
+            # Its own error type: the public error names it (the schema cannot say that
+            # one field excludes another's values).
+            raise PydanticCustomError(
+                "budget_with_tier", "an error budget chooses the setting: use quality 'auto' "
+                "(or leave quality out), not a tier")
         return value
 
 

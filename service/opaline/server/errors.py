@@ -148,14 +148,23 @@ def problem(status: int, reason: str, detail: str | list[str],
     return JSONResponse({"error": reason, "detail": lines}, status_code=status, headers=headers)
 
 
+def validation_code(errors: list[Any]) -> str:
+    """``budget_with_tier`` when that cross-field rule is the only problem, else ``invalid``."""
+    kinds = {err.get("type") for err in errors}
+    return "budget_with_tier" if kinds == {"budget_with_tier"} else "invalid"
+
+
 async def on_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
-    request.app.state.metrics.reject("invalid")
+    code = validation_code(list(exc.errors()))
+    request.app.state.metrics.reject(code)
     model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
-    return problem(422, "invalid", _validation_lines(list(exc.errors()), model))
+    return problem(422, code, _validation_lines(list(exc.errors()), model))
 
 
 async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
     status, reason = next(v for k, v in PUBLIC_ERRORS.items() if isinstance(exc, k))
+    if isinstance(exc, ValidationError):
+        reason = validation_code(exc.errors())
     state = request.app.state
     state.metrics.reject(reason)
     if isinstance(exc, ValidationError):
