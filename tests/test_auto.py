@@ -178,6 +178,7 @@ def test_cli_verbose_says_what_auto_picked(tmp_path):
         capture_output=True, text=True, cwd=ROOT, timeout=120,
         env={**__import__("os").environ, "PYTHONPATH": str(ROOT / "service")})
     assert done.returncode == 0, done.stderr
-    assert "quality auto: samples=" in done.stderr and "target: max_flip=0.05" in done.stderr
+    assert "quality=auto samples=" in done.stderr and "target: max_flip=0.05" in done.stderr
+    assert "quality=auto picked:" in done.stderr and "basis:" in done.stderr
     assert out.exists()
 
