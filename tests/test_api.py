@@ -497,3 +497,12 @@ def test_not_ready_until_the_start_up_calibration_is_done(backend):
             time.sleep(0.1)
         assert client.get("/readyz").json()["calibrated"] is True
         assert client.get(f"/v1/render?{SMALL}&mu_f=2.5").status_code == 200
+
+
+def test_quality_auto_says_what_it_picked(client):
+    """A render with an error budget answers with the setting quality=auto chose and why."""
+    answer = client.get("/v1/render?preset=cd-rom&width=128&height=128&max_flip=0.05")
+    assert answer.status_code == 200
+    assert answer.headers["X-Opaline-Auto-Target"] == "max_flip=0.05"
+    assert "samples=" in answer.headers["X-Opaline-Auto-Setting"]
+    assert "X-Opaline-Auto-Target" not in client.get(f"/v1/render?{SMALL}").headers

@@ -15,6 +15,7 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
+from opaline.model.auto import auto_headers
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
@@ -135,7 +136,7 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest,
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
     url = canonical_url(query, key)
-    headers = {"Content-Location": url}
+    headers = {"Content-Location": url, **auto_headers(job)}  # what quality=auto picked
     if request.method == "GET" and is_canonical(request.url.query, url):
         headers["Cache-Control"] = IMMUTABLE
     return await answer_image(svc, request, key, ImageTask(job, preset), job.format, preset.name,
