@@ -44,9 +44,13 @@ def test_import_refuses_what_it_cannot_take():
     mesh, _ = build_assets(get_preset("sphere"))
     document = pygltflib.GLTF2.load_from_bytes(export_glb(mesh, Material()))
     document.materials[0].extras = {}
-    document.materials[0].extensions = {"KHR_materials_iridescence": {"iridescenceFactor": 1}}
-    with pytest.raises(GltfImportError, match="thin-film"):
+    with pytest.raises(GltfImportError, match="extras.opaline"):
         import_glb(b"".join(document.save_to_bytes()))
+    for film, why in [({}, "film is off"), ({"iridescenceFactor": 1, "iridescenceIor": 9.0},
+                                            "film_ior")]:
+        document.materials[0].extensions = {"KHR_materials_iridescence": film}
+        with pytest.raises(GltfImportError, match=why):
+            import_glb(b"".join(document.save_to_bytes()))
 
 
 @pytest.mark.gl

@@ -53,7 +53,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="FILE.glsl (or .frag) or FILE.glb")
     add_common(export)
     export.set_defaults(func=cmd_export)
-    imp = sub.add_parser("import", help="a .glb exported by Opaline → a material file (JSON)")
+    imp = sub.add_parser("import", help="a .glb exported by Opaline, or any .glb with "
+                                        "KHR_materials_iridescence → a material file (JSON)")
     imp.add_argument("source", metavar="FILE.glb")
     imp.add_argument("--preset", default="sphere", help="preset for lights and background")
     imp.add_argument("-o", "--output", required=True, metavar="FILE.json")

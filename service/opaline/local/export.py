@@ -15,9 +15,9 @@ from typing import Any, Literal
 from opaline.gl.export_glsl import export_glsl
 from opaline.model.meshes import file_mesh_preset
 from opaline.model.params import RenderRequest
-from opaline.model.presets import build_assets, get_preset
+from opaline.model.presets import get_preset
 from opaline.model.request import resolve
-from opaline.output.gltf import export_glb, import_glb, tangent_fields
+from opaline.output.gltf import export_preset_glb, import_glb
 from opaline.settings import get_settings
 
 ExportKind = Literal["glsl", "glb"]
@@ -33,8 +33,7 @@ def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind
     job = resolve(request, preset)
     if kind == "glsl":
         return export_glsl(job.material, job.wavelengths).encode()
-    mesh, _ = build_assets(preset)
-    return export_glb(mesh, job.material, job.wavelengths, preset.name, tangent_fields(preset))
+    return export_preset_glb(preset, job.material, job.wavelengths)
 
 
 def import_material(path: Path | str, preset: str = "sphere") -> dict[str, Any]:

@@ -6,7 +6,8 @@ indices) and one material: a metallic-roughness approximation for viewers
 that know nothing else, and in ``extras.opaline`` the paper's parameters
 exactly, which ``import_glb`` reads back into request fields. The paper's
 multi-peak and Ashikhmin-Shirley MDFs have no glTF extension; thin-film
-materials (KHR_materials_iridescence) are not in this branch yet.
+materials are also written as KHR_materials_iridescence (gltf_iridescence.py),
+and a .glb with that extension and no extras imports as a thin-film material.
 """
 
 from __future__ import annotations
@@ -21,7 +22,16 @@ import pygltflib as gl
 from opaline import __version__
 from opaline.model.meshes import is_mesh
 from opaline.model.params import MATERIAL_FIELDS, Material
-from opaline.model.presets import Preset
+from opaline.model.presets import Preset, build_assets, build_thickness
+from opaline.output.gltf_iridescence import (
+    IOR,
+    IRIDESCENCE,
+    add_thickness_texture,
+    is_thin_film,
+    thickness_png,
+    thin_film_extensions,
+    thin_film_fields,
+)
 from opaline.scene.mesh import Mesh
 
 EXTRAS_KEY = "opaline"
@@ -29,16 +39,19 @@ EXTRAS_KEY = "opaline"
 
 def _roughness(material: Material) -> float:
     """A rough stand-in for viewers: the MDF's width as GGX-like roughness (no exact map)."""
-    if material.mdf == "ashikhmin":
+    if material.mdf == "ashikhmin" or material.iridescence != "rotation":  # A-S lobe
         exponent = max(min(material.ex, material.ey), 1e-3)
         return float(np.clip(np.sqrt(2.0 / (exponent + 2.0)), 0.02, 1.0))
     return float(np.clip(0.15 * (material.alpha + material.beta) / 2.0, 0.05, 1.0))
 
 
 def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str = "opaline",
-               tangents: dict[str, Any] | None = None) -> bytes:
+               tangents: dict[str, Any] | None = None,
+               thickness: np.ndarray | None = None) -> bytes:
     """``tangents``: the request fields (``tangent_field``, ``tangent_axis``) that give the
-    mesh's tangents back when it is imported (the CD's are concentric, not its UVs')."""
+    mesh's tangents back when it is imported (the CD's are concentric, not its UVs').
+    ``thickness``: the preset's [0, 1] film-thickness field, written as KHR's thickness
+    texture when the material is a thin film."""
     arrays = [
         (mesh.positions, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
         (mesh.normals, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
@@ -60,12 +73,22 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
             accessor.max = mesh.positions.max(axis=0).tolist()
         accessors.append(accessor)
         blob += raw + b"\0" * (-len(raw) % 4)
+    film = is_thin_film(material)
+    image_view = None
+    if film and thickness is not None:
+        raw = thickness_png(thickness)
+        image_view = len(views)
+        views.append(gl.BufferView(buffer=0, byteOffset=len(blob), byteLength=len(raw)))
+        blob += raw + b"\0" * (-len(raw) % 4)
     params = material.model_dump(mode="json")
+    # A thin film lies on a dielectric (KHR_materials_ior), whose diffuse is the base colour.
+    colour = np.asarray(params["albedo"]) * (min(material.kd, 1.0) if film else 1.0)
     gltf_material = gl.Material(
         name=name, doubleSided=True,
         pbrMetallicRoughness=gl.PbrMetallicRoughness(
-            baseColorFactor=[*params["albedo"], 1.0],
-            metallicFactor=float(material.ks / max(material.ks + material.kd, 1e-9)),
+            baseColorFactor=[*colour.tolist(), 1.0],
+            metallicFactor=0.0 if film else float(material.ks / max(material.ks + material.kd,
+                                                                     1e-9)),
             roughnessFactor=_roughness(material)),
         extras={EXTRAS_KEY: {"model": "Kang, Lee, Cho 2014 multi-peak anisotropic microfacet",
                              "version": __version__, "material": params,
@@ -77,6 +100,10 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         scene=0, scenes=[gl.Scene(nodes=[0])], nodes=[gl.Node(mesh=0, name=name)],
         meshes=[gl.Mesh(name=name, primitives=[primitive])], materials=[gltf_material],
         accessors=accessors, bufferViews=views, buffers=[gl.Buffer(byteLength=len(blob))])
+    if film:
+        texture = None if image_view is None else add_thickness_texture(document, image_view)
+        gltf_material.extensions = thin_film_extensions(material, texture)
+        document.extensionsUsed = [IRIDESCENCE, IOR]
     document.set_binary_blob(blob)
     return b"".join(document.save_to_bytes())
 
@@ -91,6 +118,12 @@ def tangent_fields(preset: Preset) -> dict[str, Any]:
         return {"tangent_field": "concentric", "tangent_axis": [0.0, 1.0, 0.0]}
     return {}
 
+
+def export_preset_glb(preset: Preset, material: Material, wavelengths: int = 0) -> bytes:
+    """The preset's mesh, tangent fields and (for a thin film) thickness field as .glb."""
+    mesh, _ = build_assets(preset)
+    thickness = build_thickness(preset) if is_thin_film(material) else None
+    return export_glb(mesh, material, wavelengths, preset.name, tangent_fields(preset), thickness)
 
 
 class GltfImportError(ValueError):
@@ -120,7 +153,10 @@ def import_glb(data: bytes) -> dict[str, Any]:
         tangents = ours.get("tangents") or {}
         fields.update({k: v for k, v in tangents.items() if k in ("tangent_field", "tangent_axis")})
         return fields
-    if "KHR_materials_iridescence" in (material.extensions or {}):
-        raise GltfImportError("KHR_materials_iridescence needs the thin-film model, which this "
-                           "Opaline does not have yet")
-    raise GltfImportError("the material carries no Opaline parameters (extras.opaline)")
+    if IRIDESCENCE in (material.extensions or {}):
+        try:
+            return thin_film_fields(material)
+        except ValueError as exc:
+            raise GltfImportError(str(exc)) from None
+    raise GltfImportError("the material carries neither Opaline parameters (extras.opaline) "
+                          f"nor {IRIDESCENCE}")

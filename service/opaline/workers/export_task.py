@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from opaline.model.params import Material
-from opaline.model.presets import Preset, build_assets
-from opaline.output.gltf import export_glb, tangent_fields
+from opaline.model.presets import Preset
+from opaline.output.gltf import export_preset_glb
 from opaline.workers.tasks import StopCheck
 
 EXPORT_LABEL = "export-glb"
@@ -25,9 +25,7 @@ class GlbTask:
     label: str = EXPORT_LABEL
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
-        mesh, _ = build_assets(self.preset)
-        return export_glb(mesh, self.material, self.wavelengths, self.preset.name,
-                          tangent_fields(self.preset))
+        return export_preset_glb(self.preset, self.material, self.wavelengths)
 
     def units(self) -> tuple[str, float, int]:
         return EXPORT_LABEL, 0.0, 0

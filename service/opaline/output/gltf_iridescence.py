@@ -1,0 +1,115 @@
+"""Thin-film materials in glTF: KHR_materials_iridescence (and KHR_materials_ior) both ways.
+
+Export maps a ``thin-film`` material exactly: iridescenceFactor 1 (Opaline has no
+blend between film and bare substrate), iridescenceIor = film_ior,
+iridescenceThicknessMinimum/Maximum = film_thickness_min/max (nm), and the base
+material's KHR_materials_ior ior = substrate_ior, because KHR's Airy term takes
+the base material's IOR as the medium under the film (n3), as Opaline does. The
+base is written dielectric (metallicFactor 0): Opaline's substrate is a lossless
+dielectric, and a metallic base would make KHR viewers use the base colour's
+complex Fresnel under the film instead. A preset's thickness field is written as
+iridescenceThicknessTexture: 8-bit grey RGB (KHR reads G), 1/255 of the range
+per step.
+
+Import reads the same names back, with the extension's defaults (ior 1.3,
+thickness 100-400 nm) where a key is absent and the glTF base ior 1.5 without
+KHR_materials_ior. A thickness texture in the file is not imported: the request
+has no per-material thickness field (it belongs to the preset), so the film is
+film_thickness_max everywhere, as KHR's is without a texture.
+"""
+
+from __future__ import annotations
+
+import io
+from typing import Any
+
+import numpy as np
+import pygltflib as gl
+from PIL import Image
+from pydantic import ValidationError
+
+from opaline.model.params import Material, MaterialFields
+
+IRIDESCENCE = "KHR_materials_iridescence"
+IOR = "KHR_materials_ior"
+# KHR_materials_iridescence's defaults (iridescenceFactor's is 0: no film).
+KHR_IOR, KHR_THICKNESS_MIN, KHR_THICKNESS_MAX = 1.3, 100.0, 400.0
+GLTF_BASE_IOR = 1.5  # glTF's dielectric base without KHR_materials_ior
+
+
+def is_thin_film(material: Material) -> bool:
+    return material.iridescence == "thin-film"
+
+
+def thin_film_extensions(material: Material, thickness_texture: int | None) -> dict[str, Any]:
+    """The material's ``extensions`` entries; ``thickness_texture``: a texture index or None."""
+    film: dict[str, Any] = {
+        "iridescenceFactor": 1.0,
+        "iridescenceIor": float(material.film_ior),
+        "iridescenceThicknessMinimum": float(material.film_thickness_min),
+        "iridescenceThicknessMaximum": float(material.film_thickness_max),
+    }
+    if thickness_texture is not None:
+        film["iridescenceThicknessTexture"] = {"index": thickness_texture, "texCoord": 0}
+    return {IRIDESCENCE: film, IOR: {"ior": float(material.substrate_ior)}}
+
+
+def thickness_png(field: np.ndarray) -> bytes:
+    """The [0, 1] field as a grey RGB PNG, row 0 at the top: Opaline's fields are stored
+    with v = 1 on row 0, and the export writes glTF's t = 1 - v, so rows map unchanged."""
+    grey = np.round(np.clip(field, 0.0, 1.0) * 255.0).astype(np.uint8)
+    out = io.BytesIO()
+    Image.fromarray(np.repeat(grey[:, :, None], 3, axis=2), "RGB").save(out, "PNG")
+    return out.getvalue()
+
+
+def add_thickness_texture(document: gl.GLTF2, buffer_view: int) -> int:
+    """Image, repeating mipmapped sampler (the fields tile) and texture; the texture's index."""
+    document.images.append(gl.Image(bufferView=buffer_view, mimeType="image/png"))
+    document.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR,
+                                        wrapS=gl.REPEAT, wrapT=gl.REPEAT))
+    document.textures.append(gl.Texture(sampler=len(document.samplers) - 1,
+                                        source=len(document.images) - 1))
+    return len(document.textures) - 1
+
+
+def _number(block: dict[str, Any], key: str, default: float) -> float:
+    value = block.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"{key} must be a number, not {value!r}")
+    return float(value)
+
+
+def thin_film_fields(material: gl.Material) -> dict[str, Any]:
+    """Request fields of a material carrying KHR_materials_iridescence (ValueError if the
+    film is off or outside Opaline's ranges). The base's roughness becomes the A-S lobe's
+    exponents (the inverse of the export's stand-in), its colour the diffuse albedo."""
+    extensions = material.extensions or {}
+    film = extensions.get(IRIDESCENCE)
+    ior = extensions.get(IOR) or {}
+    if not isinstance(film, dict) or not isinstance(ior, dict):
+        raise ValueError(f"{IRIDESCENCE} must be an object")
+    if _number(film, "iridescenceFactor", 0.0) <= 0.0:
+        raise ValueError(f"{IRIDESCENCE} has iridescenceFactor 0: the film is off")
+    pbr = material.pbrMetallicRoughness or gl.PbrMetallicRoughness()
+    roughness = float(np.clip(pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0,
+                              0.02, 1.0))
+    metallic = pbr.metallicFactor if pbr.metallicFactor is not None else 1.0
+    colour = list(pbr.baseColorFactor or [1.0, 1.0, 1.0, 1.0])[:3]
+    exponent = float(min(2.0 / roughness**2 - 2.0, 1e6))
+    fields = {
+        "iridescence": "thin-film",
+        "film_ior": _number(film, "iridescenceIor", KHR_IOR),
+        "film_thickness_min": _number(film, "iridescenceThicknessMinimum", KHR_THICKNESS_MIN),
+        "film_thickness_max": _number(film, "iridescenceThicknessMaximum", KHR_THICKNESS_MAX),
+        "substrate_ior": _number(ior, "ior", GLTF_BASE_IOR),
+        "ex": exponent, "ey": exponent, "ks": 1.0,
+        "kd": float(np.clip(1.0 - metallic, 0.0, 1.0)),
+        "albedo": [float(np.clip(c, 0.0, 1.0)) for c in colour],
+    }
+    try:
+        MaterialFields.model_validate(fields)
+    except ValidationError as exc:
+        problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())
+        raise ValueError(f"{IRIDESCENCE} outside Opaline's ranges: {problems}") from None
+    return fields

@@ -1,0 +1,112 @@
+"""Thin-film materials leave as KHR_materials_iridescence (+ KHR_materials_ior) with the
+exact values, a .glb carrying only the extension imports as a thin film and renders, and
+export → import keeps every field."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pygltflib
+import pytest
+from PIL import Image
+
+from opaline.local.export import export_material, import_material
+from opaline.model.params import Material, RenderRequest
+from opaline.model.presets import build_assets, build_thickness, get_preset
+from opaline.output.gltf import export_glb, import_glb
+
+FILM = {"iridescence": "thin-film", "film_ior": 1.45, "film_thickness_min": 120.0,
+        "film_thickness_max": 730.0, "substrate_ior": 1.62}
+FIELDS = tuple(FILM)
+
+
+def _load(data: bytes) -> pygltflib.GLTF2:
+    return pygltflib.GLTF2.load_from_bytes(data)
+
+
+def test_thin_film_exports_the_extension_exactly():
+    document = _load(export_material({"preset": "sphere", **FILM}, "glb"))
+    assert {"KHR_materials_iridescence", "KHR_materials_ior"} <= set(document.extensionsUsed)
+    material = document.materials[0]
+    assert material.extensions["KHR_materials_iridescence"] == {
+        "iridescenceFactor": 1.0, "iridescenceIor": 1.45, "iridescenceThicknessMinimum": 120.0,
+        "iridescenceThicknessMaximum": 730.0}  # the sphere has no thickness field
+    assert material.extensions["KHR_materials_ior"] == {"ior": 1.62}
+    assert material.pbrMetallicRoughness.metallicFactor == 0.0  # a dielectric under the film
+    assert material.extras["opaline"]["material"]["film_ior"] == 1.45
+    # The paper's materials carry no extension.
+    plain = _load(export_material({"preset": "sphere"}, "glb"))
+    assert not plain.extensionsUsed and not plain.materials[0].extensions
+
+
+def test_thickness_field_becomes_the_thickness_texture():
+    document = _load(export_material({"preset": "oil-film"}, "glb"))
+    film = document.materials[0].extensions["KHR_materials_iridescence"]
+    texture = document.textures[film["iridescenceThicknessTexture"]["index"]]
+    view = document.bufferViews[document.images[texture.source].bufferView]
+    blob = document.binary_blob()[view.byteOffset:view.byteOffset + view.byteLength]
+    green = np.asarray(Image.open(io.BytesIO(blob)).convert("RGB"))[:, :, 1] / 255.0
+    field = build_thickness(get_preset("oil-film"))
+    assert green.shape == field.shape
+    np.testing.assert_allclose(green, field, atol=0.5 / 255 + 1e-6)
+
+
+def _khr_only(film: dict, ior: float | None, roughness: float = 0.3) -> bytes:
+    """A .glb as another tool writes it: the sphere with a KHR material and no extras."""
+    mesh, _ = build_assets(get_preset("sphere"))
+    document = _load(export_glb(mesh, Material()))
+    extensions = {"KHR_materials_iridescence": film}
+    if ior is not None:
+        extensions["KHR_materials_ior"] = {"ior": ior}
+    document.materials[0] = pygltflib.Material(
+        name="bubble", extensions=extensions,
+        pbrMetallicRoughness=pygltflib.PbrMetallicRoughness(
+            baseColorFactor=[0.1, 0.2, 0.3, 1.0], metallicFactor=0.0, roughnessFactor=roughness))
+    document.extensionsUsed = list(extensions)
+    return b"".join(document.save_to_bytes())
+
+
+def test_khr_only_glb_imports_as_thin_film():
+    film = {"iridescenceFactor": 1.0, "iridescenceIor": 1.8, "iridescenceThicknessMinimum": 50.0,
+            "iridescenceThicknessMaximum": 900.0}
+    fields = import_glb(_khr_only(film, 1.2))
+    assert {k: fields[k] for k in FIELDS} == {
+        "iridescence": "thin-film", "film_ior": 1.8, "film_thickness_min": 50.0,
+        "film_thickness_max": 900.0, "substrate_ior": 1.2}
+    assert fields["albedo"] == [0.1, 0.2, 0.3] and fields["kd"] == 1.0
+    assert fields["ex"] == fields["ey"] == pytest.approx(2 / 0.3**2 - 2)
+    # Absent keys take the extension's defaults, the base ior glTF's 1.5.
+    fields = import_glb(_khr_only({"iridescenceFactor": 1.0}, None))
+    assert {k: fields[k] for k in FIELDS[1:]} == {
+        "film_ior": 1.3, "film_thickness_min": 100.0, "film_thickness_max": 400.0,
+        "substrate_ior": 1.5}
+
+
+@pytest.mark.gl
+@pytest.mark.usefixtures("shared_renderer")
+def test_khr_only_glb_renders(tmp_path):
+    from opaline import render_array
+
+    path = tmp_path / "film.glb"
+    path.write_bytes(_khr_only({"iridescenceFactor": 1.0, "iridescenceIor": 1.33,
+                                "iridescenceThicknessMaximum": 450.0}, 1.0, roughness=0.15))
+    fields = import_material(path)
+    RenderRequest.model_validate(fields)
+    image = render_array({**fields, "width": 48, "height": 48, "quality": "draft"})
+    rgb = image[..., :3][image[..., 3] > 0.5]
+    assert rgb.size and np.isfinite(rgb).all() and rgb.max() > 0.0
+    # A 450 nm soap film is coloured: its channels differ somewhere on the sphere.
+    assert np.ptp(rgb, axis=1).max() > 0.02
+
+
+@pytest.mark.parametrize("preset", ["sphere", "oil-film", "soap-bubble"])
+def test_round_trip_keeps_thin_film_fields(preset):
+    request = RenderRequest(preset=preset, **FILM)
+    fields = import_glb(export_material(request, "glb"))
+    assert {k: fields[k] for k in FIELDS} == FILM
+    # Without extras the extension alone gives the same film.
+    document = _load(export_material(request, "glb"))
+    document.materials[0].extras = {}
+    fields = import_glb(b"".join(document.save_to_bytes()))
+    assert {k: fields[k] for k in FIELDS} == FILM
