@@ -69,3 +69,17 @@ def shared_renderer(renderer, monkeypatch):
             pass
 
     monkeypatch.setattr(pipeline, "LocalRenderer", Shared)
+
+
+@pytest.fixture()
+def cost_budget(monkeypatch):
+    """Sets OPALINE_COST_BUDGET for one test (settings are read once, so the cache is reset)."""
+    from opaline.settings import get_settings
+
+    def set_budget(value: int) -> None:
+        monkeypatch.setenv("OPALINE_COST_BUDGET", str(value))
+        get_settings.cache_clear()
+
+    yield set_budget
+    monkeypatch.delenv("OPALINE_COST_BUDGET", raising=False)
+    get_settings.cache_clear()

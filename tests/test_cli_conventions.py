@@ -18,7 +18,6 @@ from opaline import __version__
 from opaline.cli import main as cli
 from opaline.model.presets import all_presets
 from opaline.resources import PRESETS_ENV, builtin_presets_dir
-from opaline.settings import get_settings
 
 ROOT = Path(__file__).resolve().parent.parent
 TINY = ["--size", "16x16", "--quality", "draft"]
@@ -230,17 +229,6 @@ def test_presets_dir_is_offered_by_the_commands_that_read_presets(capsys):
         with pytest.raises(SystemExit):
             cli.main([command, "--help"])
         assert "--presets-dir" in capsys.readouterr().out, command
-
-
-@pytest.fixture()
-def cost_budget(monkeypatch):
-    def set_budget(value: int) -> None:
-        monkeypatch.setenv("OPALINE_COST_BUDGET", str(value))
-        get_settings.cache_clear()
-
-    yield set_budget
-    monkeypatch.delenv("OPALINE_COST_BUDGET", raising=False)
-    get_settings.cache_clear()
 
 
 @pytest.mark.gl

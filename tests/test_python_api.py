@@ -102,20 +102,6 @@ def test_render_of_a_material_file_given_as_str(on_thread, tmp_path):
         on_thread(api_python.render, str(tmp_path / "missing.toml"))
 
 
-@pytest.fixture()
-def cost_budget(monkeypatch):
-    """Sets OPALINE_COST_BUDGET for one test (settings are read once, so the cache is reset)."""
-    from opaline.settings import get_settings
-
-    def set_budget(value: int) -> None:
-        monkeypatch.setenv("OPALINE_COST_BUDGET", str(value))
-        get_settings.cache_clear()
-
-    yield set_budget
-    monkeypatch.delenv("OPALINE_COST_BUDGET", raising=False)
-    get_settings.cache_clear()
-
-
 def test_cost_budget_comes_from_the_environment(on_thread, cost_budget):
     """OPALINE_COST_BUDGET bounds the Python API as it bounds the HTTP service."""
     from opaline.model.request import CostError

@@ -119,7 +119,8 @@ def test_admission_refuses_at_once_and_keeps_small_requests_on_time(env):
     deadline = 6.0
     with LocalServer(env={**env, "OPALINE_DEADLINE_S": str(deadline)}) as server:
         get(server.base + "/v1/render?width=64&height=64&quality=draft")  # warm
-        slow = server.base + "/v1/render?width=2048&height=2048&samples=64"
+        # Within the cost budget (RGB), but far over the deadline when predicted.
+        slow = server.base + "/v1/render?width=2048&height=2048&samples=64&wavelengths=0"
         refusals = [get(slow) for _ in range(5)]
         assert all(r[0] == 422 and b"predicted" in r[1] for r in refusals)
         print(f"\nrefusal times: {[round(r[3] * 1e3, 1) for r in refusals]} ms")
@@ -179,7 +180,8 @@ def test_sigkill_of_a_batch_leaves_no_process_behind(tmp_path, env):
     materials.mkdir()
     for i in range(6):
         (materials / f"m{i}.toml").write_text(
-            f'preset = "cd-rom"\nwidth = 1024\nheight = 1024\nsamples = 64\nmu_f = {i + 1}\n')
+            f'preset = "cd-rom"\nwidth = 1024\nheight = 1024\nsamples = 64\nwavelengths = 0\n'
+            f'mu_f = {i + 1}\n')
     batch = subprocess.Popen([sys.executable, "-m", "opaline.cli.main", "batch", str(materials),
                               "--out", str(tmp_path / "out"), "--jobs", "2"],
                              env=loopback_env(**env), stdout=subprocess.DEVNULL,
