@@ -52,3 +52,37 @@ def test_weights_are_white_balanced_and_shared_read_only(count):
     assert rgb_weights(count) is weights
     with pytest.raises(ValueError):
         weights[0, 0] = 1.0
+
+
+def test_shipped_cmfs_are_colour_sciences():
+    """The CIE 1931 table shipped with the package gives colour-science's interpolated values
+    (to 1e-5; the weights to 2e-6) at any wavelength. Regenerate the file with:
+    np.save(path, column_stack([lam, MSDS_CMFS[...][lam]])) for lam = 360 … 830 by 0.1 nm."""
+    import colour
+    import numpy as np
+
+    from opaline.model import spectrum
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    lam = np.random.default_rng(7).uniform(380.0, 780.0, 500)
+    assert np.abs(spectrum.cie_xyz(lam) - np.asarray(cmfs[lam])).max() < 1e-5
+    assert np.allclose(spectrum.XYZ_TO_SRGB, colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB)
+    for count, shift in ((4, 0.5), (16, 0.123), (128, 0.9)):
+        rgb = np.asarray(cmfs[spectrum.sample_wavelengths(count, shift)]) @ spectrum.XYZ_TO_SRGB.T
+        expected = rgb / rgb.sum(axis=0, keepdims=True)
+        assert np.abs(spectrum.rgb_weights(count, shift) - expected).max() < 2e-6
+
+
+def test_spectral_weights_do_not_import_colour_science():
+    """A spectral render's weights come from the shipped table: no colour-science (and its
+    scipy and matplotlib imports, over a second cold) in the rendering process."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from opaline.model.spectrum import rgb_weights; rgb_weights(8); "
+            "from opaline.model.visible import density_table; density_table(); "
+            "assert 'colour' not in sys.modules and 'scipy' not in sys.modules, "
+            "sorted(m for m in sys.modules if m.startswith(('colour', 'scipy')))[:5]")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr

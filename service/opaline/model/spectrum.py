@@ -6,7 +6,7 @@ below 465 nm, 0 above 612 nm): the paper gives rotations for its three
 primaries only, and extending the lines invents rotations up to ±19 rad at
 θ = ±2π that no RGB render has and that need hundreds of wavelengths to
 converge (docs/accuracy.md, "Spectral extremes"). The MDF at each wavelength is
-weighted by the CIE 1931 2° colour matching functions (from colour-science),
+weighted by the CIE 1931 2° colour matching functions (colour-science's table),
 taken to linear sRGB and white balanced so a flat spectrum (equal D
 everywhere) gives equal R, G, B.
 
@@ -17,9 +17,8 @@ of W wavelengths integrate the spectrum at N·W points instead of W.
 
 from __future__ import annotations
 
-import warnings
 from functools import lru_cache
-from typing import Any
+from pathlib import Path
 
 import numpy as np
 
@@ -51,27 +50,34 @@ def rotation_at(wavelengths: np.ndarray, theta1: float, theta2: float) -> np.nda
     return np.interp(lam, xs, ys)  # np.interp holds the end values outside xs
 
 
-def _import_colour() -> Any:
-    """colour-science, imported late: it is slow to import and only spectral renders need it.
+# XYZ to linear sRGB (IEC 61966-2-1), the matrix colour-science uses for sRGB.
+XYZ_TO_SRGB = np.array([[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415],
+                        [0.0557, -0.204, 1.057]])
+# The CIE 1931 2° colour matching functions, 360-830 nm, as colour-science interpolates
+# its 1 nm table (Sprague), sampled at 0.1 nm and shipped with the package: linear
+# interpolation between those samples is within 1e-5 of colour-science's values, and a
+# render does not pay for importing colour-science and scipy (over a second cold).
+# Regenerate with tests/test_spectrum.py's instructions; a test compares the two.
+CMFS_FILE = Path(__file__).with_name("cie1931_cmfs.npy")
 
-    Without matplotlib (not a dependency: Opaline uses none of colour's plotting) its import
-    warns that the plotting API is unavailable; only that warning is silenced."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings(
-            "ignore", message='"Matplotlib" related API features are not available')
-        import colour
-    return colour
+
+@lru_cache(maxsize=1)
+def _cmfs_table() -> tuple[np.ndarray, np.ndarray]:
+    data = np.load(CMFS_FILE)
+    return data[:, 0], data[:, 1:]
+
+
+def cie_xyz(lam: np.ndarray) -> np.ndarray:
+    """x̄, ȳ, z̄ of the CIE 1931 2° observer at ``lam`` nm, shape ``lam.shape + (3,)``."""
+    grid, xyz = _cmfs_table()
+    lam = np.asarray(lam, dtype=np.float64)
+    return np.stack([np.interp(lam, grid, xyz[:, i]) for i in range(3)], axis=-1)
 
 
 @lru_cache(maxsize=256)
 def rgb_weights(count: int, shift: float = CENTRE) -> np.ndarray:
     """(count, 3) weights from per-wavelength D to linear sRGB; columns sum to 1."""
-    colour = _import_colour()
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    lam = sample_wavelengths(count, shift)
-    xyz = np.asarray(cmfs[lam])  # (count, 3), interpolated by colour-science
-    to_rgb = colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB
-    rgb = xyz @ to_rgb.T
+    rgb = cie_xyz(sample_wavelengths(count, shift)) @ XYZ_TO_SRGB.T
     weights = rgb / rgb.sum(axis=0, keepdims=True)
     weights.setflags(write=False)  # cached and shared: a caller must not change it in place
     return weights

@@ -24,7 +24,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from opaline.model.spectrum import RANGE_NM
+from opaline.model.spectrum import RANGE_NM, XYZ_TO_SRGB, cie_xyz
 
 TABLE_STEP_NM = 5.0
 TABLE_SIZE = int((RANGE_NM[1] - RANGE_NM[0]) / TABLE_STEP_NM) + 1  # 81 entries, both ends
@@ -40,11 +40,8 @@ _FIT = np.array(
 
 
 def _fine_density() -> tuple[np.ndarray, np.ndarray]:
-    import colour  # late: slow to import, only the physical sources need it here
-
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     lam = np.arange(RANGE_NM[0], RANGE_NM[1] + 0.5, 1.0)
-    rgb = np.array([cmfs[w] for w in lam]) @ colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB.T
+    rgb = cie_xyz(lam) @ XYZ_TO_SRGB.T
     return lam, rgb / np.trapezoid(rgb, lam, axis=0)
 
 
