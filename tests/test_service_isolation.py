@@ -225,18 +225,22 @@ def test_the_http_process_never_loads_gl(backend, tmp_path):
 def test_a_client_that_leaves_takes_its_queued_render_with_it(env):
     """A request whose client disconnects while it waits in the queue is dropped: the
     worker never renders it (counted as cancelled)."""
+    import json
     import socket
 
     with LocalServer(env={**env, "OPALINE_DEADLINE_S": "300",
                           "OPALINE_RENDER_TIMEOUT_S": "300"}) as server:
         busy = threading.Thread(target=get, args=(
-            server.base + "/v1/mdf?size=2048&wavelengths=64", 300))
+            server.base + "/v1/mdf?size=2048&wavelengths=128", 300))
         busy.start()
         time.sleep(0.5)
         with socket.create_connection(("127.0.0.1", server.port)) as sock:
             sock.sendall(b"GET /v1/render?width=64&height=64&quality=draft&mu_f=7 HTTP/1.1\r\n"
                          b"Host: 127.0.0.1\r\n\r\n")
-            time.sleep(0.5)  # queued behind the plot
+            end = time.monotonic() + 5  # until it waits in the queue behind the plot
+            while json.loads(get(server.base + "/readyz")[1])["queue_depth"] < 1:
+                assert time.monotonic() < end, "the render never queued behind the plot"
+                time.sleep(0.02)
         end = time.monotonic() + 10
         text = ""
         while time.monotonic() < end and "opaline_jobs_cancelled_total 1.0" not in text:
