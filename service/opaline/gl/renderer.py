@@ -13,7 +13,7 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from opaline.gl import passes, physical, uniforms
+from opaline.gl import heightfield, passes, physical, uniforms
 from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import (
     Cancelled,
@@ -159,6 +159,7 @@ class Renderer(Kept, Probes, Resolve):
             "u_ambient": tuple(preset.ambient),
             "u_aa_scale": samples.aa_scale,
             "u_exposure": job.exposure,
+            **heightfield.uniforms(preset),
         })
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
