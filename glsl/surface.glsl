@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING THICKNESS_MAP TRANSMISSION DISPLAY TONEMAP_REINHARD TONEMAP_ACES
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -70,6 +70,10 @@ uniform float u_lod_bias;
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
 uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickness texture
 #endif
+#ifdef WAVES
+#include "lib/waves.glsl"
+uniform mat3 u_normal_matrix;
+#endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
 uniform vec3 u_backdrop;  // linear radiance that displays as the background colour
 #endif
@@ -92,6 +96,13 @@ void main() {
         n = vec3(0.0, 1.0, 0.0);  // zero-area triangles can interpolate to nothing
     }
     vec3 t = tangent_field();
+#ifdef WAVES
+    // The heightfield's own normal and tangent (dP/dx) here, as waves.py gives them at
+    // the vertices: exact at any mesh density, so a thumbnail's mesh can be coarse.
+    vec2 slope = wave_slope(v_object.xz);
+    n = u_normal_matrix * vec3(-slope.x, 1.0, -slope.y);
+    t = mat3(u_model) * vec3(1.0, slope.x, 0.0);
+#endif
 #ifdef NORMAL_MAP
     vec3 mapped = texture(u_normal_map, v_uv, u_lod_bias).xyz;
     // A zero normal in the map keeps the geometric one.

@@ -14,6 +14,7 @@ import moderngl
 import numpy as np
 
 from opaline.gl import physical
+from opaline.gl.culling import Culling
 from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset, build_assets, build_thickness
 
@@ -131,6 +132,7 @@ class SceneGPU:
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.normal_map.repeat_x = self.normal_map.repeat_y = True
         self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset))
+        self.culling = Culling(mesh.positions, mesh.indices)
         # Mipmaps add a third to a texture.
         self.nbytes = self.vbo.size + self.ibo.size + sum(
             tex.width * tex.height * tex.components * 4 * 4 // 3

@@ -6,13 +6,15 @@ shading (docs/speed.md). Up to ``THUMBNAIL`` pixels on the longer side, the
 generator's density arguments are halved (a quarter of the triangles): at
 256² a sphere segment still spans ~9 px and the silhouette is within 0.1 px
 of the true circle, and normals and tangents are interpolated per fragment as
-before. Larger images draw the preset as written.
+before. The wavy sheet, whose slope is computed per fragment (gl/heightfield.py),
+goes to a quarter. Larger images draw the preset as written.
 """
 
 from __future__ import annotations
 
 import inspect
 
+from opaline.gl import heightfield
 from opaline.model.presets import Generator, Preset
 from opaline.scene import geometry
 
@@ -30,12 +32,13 @@ def scene_for_size(preset: Preset, width: int, height: int) -> Preset:
         return preset
     parameters = inspect.signature(factory).parameters
     args = preset.geometry.args
+    divisor = heightfield.THUMBNAIL_DIVISOR if heightfield.analytic(preset) else 2
     changed = {}
     for name in DENSITY_ARGS:
         if name in parameters:
             value = args.get(name, parameters[name].default)
             if isinstance(value, int) and value > MIN_DENSITY:
-                changed[name] = max(value // 2, MIN_DENSITY)
+                changed[name] = max(value // divisor, MIN_DENSITY)
     if not changed:
         return preset
     coarse = Generator(kind=preset.geometry.kind, **{**args, **changed})

@@ -30,6 +30,8 @@ def defines(material) -> dict[str, int | bool]:
         # The film's Airy reflectance is its Fresnel term; a grating keeps Schlick's
         # (the reflectance of its coating) where f0 < 1.
         "FRESNEL": not thin_film and material.f0 < 1.0,
+        # A define so the order and Bessel loops unroll (glsl/lib/grating.glsl).
+        "GRATING_ORDERS": False if thin_film else material.grating_orders,
     }
 
 
@@ -43,7 +45,6 @@ def uniforms(material, wavelengths: int) -> dict[str, object]:
         "u_film_thickness_max": material.film_thickness_max,
         "u_grating_pitch_nm": 1000.0 * material.grating_pitch,
         "u_grating_depth_nm": material.grating_depth,
-        "u_grating_orders": material.grating_orders,
     }
     if wavelengths > 0:
         values["u_wavelength_nm"] = [float(x) for x in sample_wavelengths(wavelengths)]

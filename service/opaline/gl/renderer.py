@@ -13,7 +13,7 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from opaline.gl import passes, physical, uniforms
+from opaline.gl import heightfield, passes, physical, uniforms
 from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import (
     Cancelled,
@@ -159,6 +159,7 @@ class Renderer(Kept, Probes, Resolve):
             "u_ambient": tuple(preset.ambient),
             "u_aa_scale": samples.aa_scale,
             "u_exposure": job.exposure,
+            **heightfield.uniforms(preset),
         })
         if normal_map is not None:
             values["u_normal_map"] = NORMAL_MAP_UNIT
@@ -173,6 +174,7 @@ class Renderer(Kept, Probes, Resolve):
             scene.thickness_map.use(location=physical.THICKNESS_UNIT)
         uniforms.apply(program, values)
         vao = scene.vao(ctx, program)
+        front_face = scene.culling.front_face(model, view_proj)
         offsets = samples.offsets
         multi = len(offsets) > 1
         if multi:
@@ -199,9 +201,13 @@ class Renderer(Kept, Probes, Resolve):
             if background is not None:
                 background(jitter)
             ctx.enable(moderngl.DEPTH_TEST)
-            ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+            ctx.disable(moderngl.BLEND)
+            if front_face is not None:  # only the surface: full-screen passes are not culled
+                ctx.front_face = front_face
+                ctx.enable(moderngl.CULL_FACE)
             program["u_jitter"].value = jitter
             vao.render(moderngl.TRIANGLES)
+            ctx.disable(moderngl.CULL_FACE)
             if multi:
                 ctx.disable(moderngl.DEPTH_TEST)
                 ctx.enable(moderngl.BLEND)

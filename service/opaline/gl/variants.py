@@ -3,7 +3,7 @@ features that are off are not compiled in (no uniform branches on them)."""
 
 from __future__ import annotations
 
-from opaline.gl import physical, uniforms
+from opaline.gl import heightfield, physical, uniforms
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 
@@ -14,6 +14,7 @@ def surface_defines(job: Job, preset: Preset) -> dict[str, int | bool]:
     defines["NORMAL_MAP"] = preset.normal_map is not None
     defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
     defines["LIGHT_COUNT"] = len(preset.lights)
+    defines.update(heightfield.defines(preset))
     if physical.uses_thickness_map(job.material, preset):
         defines["THICKNESS_MAP"] = True
     if physical.uses_transmission(job.material, preset):
