@@ -101,17 +101,24 @@ def median_of_rounds(rounds: list[list[float]]) -> float:
 
 
 def cold(rounds: int) -> dict:
-    """Cold processes, alternated: the floor script, then ``opaline render``."""
+    """Cold processes, alternated: the floor script, then ``opaline render``.
+
+    Measured as a user meets them: with bytecode written and read (an installed package
+    has its .pyc; PYTHONDONTWRITEBYTECODE would recompile every module each time), and
+    after one untimed run of each, which writes that bytecode and Mesa's shader cache."""
     out = Path(tempfile.mkdtemp())
-    floor_s, opaline_s = [], []
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    commands = (([sys.executable, str(FLOOR), "--once", str(out / "f.png")], []),
+                ([sys.executable, "-m", "opaline", "render", "sphere", "--quality", "draft",
+                  "-o", str(out / "o.png")], []))
+    for argv, _ in commands:
+        subprocess.run(argv, check=True, cwd=ROOT, capture_output=True, env=env)
     for _ in range(rounds):
-        for argv, times in (([sys.executable, str(FLOOR), "--once", str(out / "f.png")], floor_s),
-                            ([sys.executable, "-m", "opaline", "render", "sphere", "--quality",
-                              "draft", "-o", str(out / "o.png")], opaline_s)):
+        for argv, times in commands:
             start = time.perf_counter()
-            subprocess.run(argv, check=True, cwd=ROOT, capture_output=True)
+            subprocess.run(argv, check=True, cwd=ROOT, capture_output=True, env=env)
             times.append(time.perf_counter() - start)
-    floor, opaline = statistics.median(floor_s), statistics.median(opaline_s)
+    floor, opaline = (statistics.median(times) for _, times in commands)
     return {"floor_ms": 1e3 * floor, "opaline_ms": 1e3 * opaline, "ratio": opaline / floor}
 
 

@@ -1,5 +1,5 @@
 """``python -m opaline`` is the ``opaline`` command."""
 
-from opaline.cli.main import main
+from opaline.cli.main import command
 
-raise SystemExit(main())
+raise SystemExit(command())

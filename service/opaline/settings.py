@@ -1,145 +1,72 @@
-"""Service settings: one class, read from ``OPALINE_*`` environment variables.
+"""Settings, read from ``OPALINE_*`` environment variables: what every layer imports.
 
-Reached through the cached ``get_settings()`` (and, in the HTTP service, the
-``SettingsDep`` dependency of ``opaline.server.api``), so tests override the
-dependency instead of patching globals. The command line and the Python API
-read the same class: ``OPALINE_COST_BUDGET`` and ``OPALINE_PRESETS_DIR`` mean
-the same everywhere. ``gl_backend`` reads ``OPALINE_GL_BACKEND``, the same
-variable that ``opaline.gl.context`` reads when no backend is passed explicitly.
+The process's settings are the cached ``get_settings()`` (and, in the HTTP service,
+the ``SettingsDep`` dependency of ``opaline.server.api``), so tests override the
+dependency instead of patching globals. The command line and the Python API read the
+same class: ``OPALINE_COST_BUDGET`` and ``OPALINE_PRESETS_DIR`` mean the same
+everywhere. ``gl_backend`` reads ``OPALINE_GL_BACKEND``, the same variable that
+``opaline.gl.context`` reads when no backend is passed explicitly.
+
+The class (``opaline.service_settings``) needs pydantic-settings, a quarter of the
+imports of a cold ``opaline render``: it is imported on first use of ``Settings`` or
+``get_settings()``. The render path asks ``setting(name)``, which needs neither while
+no ``OPALINE_*`` variable is set, since every setting then has its default.
 """
 
 from __future__ import annotations
 
+import os
 from functools import lru_cache
-from pathlib import Path
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Any
 
-from pydantic import Field, SecretStr, field_validator
-from pydantic_settings import BaseSettings, SettingsConfigDict
+# Re-exported: the plain values are read from here.
+from opaline.setting_defaults import BACKENDS as BACKENDS
+from opaline.setting_defaults import DEFAULT_COST_BUDGET as DEFAULT_COST_BUDGET
+from opaline.setting_defaults import DEFAULTS
+from opaline.setting_defaults import MAX_PIXELS as MAX_PIXELS
+from opaline.setting_defaults import BackendName as BackendName
 
-BackendName = Literal["egl", "osmesa", "auto"]
-BACKENDS: tuple[str, ...] = get_args(BackendName)
-# 2048² at 64 samples in RGB: the largest image at the `reference` tier's sample count.
-DEFAULT_COST_BUDGET = 2048 * 2048 * 64 * 3
+if TYPE_CHECKING:
+    from pydantic import SecretStr
 
-MAX_PIXELS = 2048  # params.Pixels' upper bound: settings may lower it, never raise it
+    from opaline.service_settings import Settings
+
+ENV_PREFIX = "opaline_"  # pydantic-settings matches variable names case-insensitively
 
 
-class Settings(BaseSettings):
-    """Everything the HTTP service can be configured with."""
+def __getattr__(name: str) -> Any:
+    if name == "Settings":  # `from opaline.settings import Settings`, imported on first use
+        from opaline.service_settings import Settings
 
-    model_config = SettingsConfigDict(env_prefix="OPALINE_", extra="ignore", frozen=True)
+        return Settings
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-    gl_backend: BackendName = Field(
-        "egl", description="Headless GL backend of the render workers.")
-    host: str = Field("127.0.0.1", description="Address `opaline serve` binds.")
-    port: int = Field(8000, ge=1, le=65535, description="Port `opaline serve` binds.")
-    workers: int = Field(
-        1, ge=1, le=16,
-        description="Render worker processes, one GL context each. 1 is the measured best on a "
-                    "2-core llvmpipe machine (bench/results/http_load.md).")
-    lp_threads: int | None = Field(
-        None, ge=1, le=256,
-        description="llvmpipe threads per worker (LP_NUM_THREADS); default: cores ÷ workers.")
-    queue_size: int = Field(
-        32, ge=1, le=10_000, description="Jobs waiting for a worker before 503.")
-    deadline_s: float = Field(
-        10.0, gt=0, le=600,
-        description="Longest a request may wait for its image. A job predicted to take longer "
-                    "is refused at once (422), one that would miss it behind the queue gets "
-                    "503, and a job still queued when it passes leaves the queue (503).")
-    render_timeout_s: float = Field(
-        30.0, gt=0, le=3600,
-        description="A render running longer than this has its worker killed and replaced "
-                    "(the watchdog); the request gets 503.")
-    calibrate: bool = Field(
-        True, description="Time a few renders per preset at start-up to predict render times.")
-    worker_max_renders: int = Field(
-        1000, ge=1, description="A worker is recycled after this many renders.")
-    worker_max_rss_mb: int = Field(
-        1024, ge=256, description="A worker whose memory passes this after a render is recycled.")
-    worker_programs: int = Field(
-        64, ge=4, le=4096, description="Shader variants a worker keeps compiled (LRU).")
-    worker_scene_mb: int = Field(
-        128, ge=8, description="Bytes of uploaded meshes and normal maps a worker keeps (LRU).")
-    worker_target_mb: int = Field(
-        256, ge=218, description="Bytes of framebuffers a worker keeps (LRU); at least one "
-                                 "2048² set (218 MB).")
-    max_turntables: int = Field(
-        2, ge=1, le=64,
-        description="Turntables rendered at once; one more is refused with 429 and Retry-After. "
-                    "Their frames share one lane per worker, so other requests always find "
-                    "room in the queue.")
-    retry_after_s: int = Field(1, ge=1, le=3600, description="Retry-After sent with a 503.")
-    cache_bytes: int = Field(
-        256 * 1024 * 1024, ge=0, description="Byte budget of the in-memory image cache (0: off).")
-    cache_max_age_s: int = Field(
-        3600, ge=0, description="Cache-Control max-age of image answers to GET.")
-    max_body_bytes: int = Field(16 * 1024, ge=256, description="Largest accepted request body.")
-    max_width: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image width.")
-    max_height: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image height.")
-    cost_budget: int = Field(
-        DEFAULT_COST_BUDGET, ge=1,
-        description="Largest width×height×samples×max(wavelengths, 3) a request may cost.")
-    max_connections: int = Field(
-        1024, ge=1, description="Open connections the service accepts before answering 503.")
-    # Access control (docs/design.md, "Access control"): off until a key or a secret is set.
-    api_keys: SecretStr | None = Field(
-        None, description="Comma-separated API keys; setting any turns access control on: /v1 "
-                          "and /metrics then need X-API-Key (or Authorization: Bearer) or, for "
-                          "GET images, a signed URL.")
-    signing_key: SecretStr | None = Field(
-        None, description="Secret for HMAC-SHA256 signed GET URLs (sig=, optional exp=); "
-                          "setting it turns access control on.")
-    rate_limit_per_s: float = Field(
-        0.0, ge=0, description="Requests per second per API key or client address (0: off); "
-                               "over it: 429 with Retry-After.")
-    rate_burst: int = Field(20, ge=1, description="Requests a key or address may burst.")
-    # Connection hygiene (opaline.server.connections)
-    header_timeout_s: float = Field(
-        10.0, gt=0, le=600, description="A connection must send a request's headers within this.")
-    body_timeout_s: float = Field(
-        10.0, gt=0, le=600, description="A request's body must arrive within this.")
-    write_timeout_s: float = Field(
-        30.0, gt=0, le=3600, description="A client that reads nothing for this long is dropped.")
-    max_connections_per_client: int = Field(
-        64, ge=1, description="Open connections one client address may hold; beyond: refused.")
-    presets_dir: Path | None = Field(
-        None, description="Folder of scene presets (TOML) used instead of the built-in ones.")
-    mesh_max_bytes: int = Field(
-        64 * 1024 * 1024, ge=1024, description="Largest mesh file POST /v1/meshes accepts (413).")
-    mesh_max_triangles: int = Field(
-        2_000_000, ge=1, le=50_000_000, description="Most triangles a mesh may have (422).")
-    mesh_store_bytes: int = Field(
-        1024 * 1024 * 1024, ge=1024,
-        description="Bytes of uploaded meshes kept on disk; the least recently used go first.")
-    mesh_store_dir: Path | None = Field(
-        None, description="Where uploaded meshes are kept (default: a temporary folder).")
-    meshes_dir: Path | None = Field(
-        None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
-    environments_dir: Path | None = Field(
-        None, description="A folder of HDR environments (.hdr, .exr) requests may name.")
-    warmup: bool = Field(
-        True, description="Render a tiny image on each worker at start-up, so the first "
-                          "request does not pay for shader compilation.")
 
-    @field_validator("gl_backend", mode="before")
-    @classmethod
-    def _lower(cls, value: object) -> object:
-        return value.strip().lower() if isinstance(value, str) else value  # as context.py reads it
+@lru_cache
+def get_settings() -> Settings:
+    """The process's settings, read from the environment once."""
+    from opaline.service_settings import Settings
+
+    return Settings()
+
+
+def setting(name: str) -> Any:
+    """One of the settings a render reads, as ``get_settings()`` has it.
+
+    Without any ``OPALINE_*`` variable (and before anything built the settings) the
+    settings are their defaults, so those are returned without the class. With one,
+    even another setting's, the class reads them all, so an invalid value fails as it
+    does in the service."""
+    if name in DEFAULTS and not get_settings.cache_info().currsize and not any(
+            key.lower().startswith(ENV_PREFIX) for key in os.environ):
+        return DEFAULTS[name]
+    return getattr(get_settings(), name)
 
 
 def secrets(value: SecretStr | None) -> list[bytes]:
     """The comma-separated secrets of a setting, as bytes for hmac."""
     raw = value.get_secret_value() if value is not None else ""
     return [part.strip().encode() for part in raw.split(",") if part.strip()]
-
-
-@lru_cache
-def get_settings() -> Settings:
-    """The process's settings, read from the environment once."""
-    return Settings()
-
 
 
 # What the HTTP process holds besides its image cache (Python, FastAPI, NumPy, pydantic),

@@ -31,7 +31,7 @@ from opaline.batch.shard import select
 from opaline.batch.sheet import write_contact_sheet
 from opaline.model.materials import Item, collect
 from opaline.output.files import write_atomic
-from opaline.settings import get_settings
+from opaline.settings import setting
 
 
 class NothingToRender(ValueError):
@@ -67,7 +67,7 @@ def run_batch(inputs: list[str | Path], options: Options,
         shown = ", ".join(map(str, inputs))
         raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
     # With --server the server checks the cost, against its own budget.
-    budget = None if options.server else get_settings().cost_budget
+    budget = None if options.server else setting("cost_budget")
     # Every shard prunes against all items: the others' outputs are not "gone".
     tasks = plan(select(items, options.shard), options.out, force=options.force,
                  cost_budget=budget)

@@ -18,7 +18,7 @@ from opaline.gl import uniforms
 from opaline.gl.shaders import ProgramCache
 from opaline.model.request import Job
 from opaline.scene.environments import resolve_map
-from opaline.settings import get_settings
+from opaline.settings import setting
 
 KEPT = 4
 ENVIRONMENT_UNIT = 2  # 0: the accumulate pass's source, 1: the normal map
@@ -33,7 +33,7 @@ class Backgrounds:
     def texture(self, name: str) -> moderngl.Texture:
         found = self._maps.get(name)
         if found is None:
-            radiance = resolve_map(name, get_settings().environments_dir)
+            radiance = resolve_map(name, setting("environments_dir"))
             height, width = radiance.shape[:2]
             # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
             data = np.ascontiguousarray(radiance[::-1], dtype="f4")

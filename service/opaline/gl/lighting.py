@@ -13,7 +13,7 @@ from opaline.gl.camera import place_key_light
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.scene.environments import environment_lights
-from opaline.settings import get_settings
+from opaline.settings import setting
 
 # From bench/results/environment_lights.md (256², against K=256): each light costs about
 # as much as the rest of the shading, and ΔE00 mean falls from 2-4 (K=8) through 1-2.3
@@ -31,7 +31,7 @@ def light_uniforms(job: Job, preset: Preset) -> dict[str, list[tuple]]:
         direction, irradiance = environment_lights(
             job.environment, environment_count(job), job.environment_rotation or 0.0,
             1.0 if job.environment_intensity is None else job.environment_intensity,
-            get_settings().environments_dir)
+            setting("environments_dir"))
         return {"u_light_position": [(*map(float, d), 0.0) for d in direction],
                 "u_light_irradiance": [tuple(map(float, e)) for e in irradiance]}
     lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,

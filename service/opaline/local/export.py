@@ -18,7 +18,7 @@ from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
 from opaline.output.gltf import export_preset_glb, import_glb
-from opaline.settings import get_settings
+from opaline.settings import setting
 
 ExportKind = Literal["glsl", "glb"]
 
@@ -29,7 +29,7 @@ def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind
         request = RenderRequest.model_validate(dict(request))
     preset = get_preset(request.preset)
     if request.mesh is not None:
-        preset = file_mesh_preset(preset, request, get_settings().mesh_max_triangles)
+        preset = file_mesh_preset(preset, request, setting("mesh_max_triangles"))
     job = resolve(request, preset)
     if kind == "glsl":
         return export_glsl(job.material, job.wavelengths).encode()

@@ -19,7 +19,7 @@ from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, check_cost, check_plot_cost, resolve
 from opaline.output.encode import encode_frame, encode_mdf
-from opaline.settings import get_settings
+from opaline.settings import setting
 
 
 @dataclass
@@ -38,7 +38,7 @@ class LocalRenderer:
 
     @property
     def budget(self) -> int:
-        return get_settings().cost_budget if self.cost_budget is None else self.cost_budget
+        return setting("cost_budget") if self.cost_budget is None else self.cost_budget
 
     def __enter__(self) -> LocalRenderer:
         return self
@@ -60,7 +60,7 @@ class LocalRenderer:
         preset = get_preset(request.preset)
         if request.mesh is None:
             return preset
-        preset = file_mesh_preset(preset, request, get_settings().mesh_max_triangles)
+        preset = file_mesh_preset(preset, request, setting("mesh_max_triangles"))
         self.mesh_presets[preset.name] = preset
         return preset
 

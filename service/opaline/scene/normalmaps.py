@@ -24,7 +24,6 @@ import os
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from PIL import Image
 
 from opaline.scene import generators
 
@@ -188,6 +187,8 @@ def from_image(path) -> np.ndarray:
     Black texels decode to ``(-1, -1, -1)/√3``, not to zero; only a true zero
     vector (impossible with 8-bit ``2c/255 - 1``) is kept as zero.
     """
+    from PIL import Image  # only image files need Pillow: a cold render skips its import
+
     with Image.open(path) as image:
         rgb = np.asarray(image.convert("RGB"))
     return _decode(rgb, 255.0)

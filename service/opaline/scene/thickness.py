@@ -18,7 +18,6 @@ import os
 from collections.abc import Callable
 
 import numpy as np
-from PIL import Image
 
 from opaline.scene import generators
 
@@ -109,6 +108,8 @@ def platelets(resolution: int = 512, seed: int = 1, cells: int = 90, spread: flo
 def _file(path: str | os.PathLike) -> np.ndarray:
     if not isinstance(path, str | os.PathLike):
         raise ValueError(f"argument 'path' must be a file path, got {path!r}")
+    from PIL import Image  # only image files need Pillow: a cold render skips its import
+
     try:
         with Image.open(path) as image:
             grey = np.asarray(image.convert("F"), dtype=np.float32)
