@@ -11,7 +11,10 @@ alike. Ratios are to the floor's median over the whole run:
 
 - in-process render + PNG per preset and tier (a warm ``Renderer``);
 - HTTP cache miss per preset (draft) and tier (sphere), one client over
-  loopback to ``opaline serve`` with one worker;
+  loopback to ``opaline serve`` with one worker, and where its time goes: the
+  HTTP exchange (client time less Server-Timing total), the route's own
+  (total less render), and the wait for the worker (render) less the
+  in-process time of the same image: the hand-off;
 - HTTP cache hit: client time, and the server's own from Server-Timing;
 - cold ``opaline render sphere --quality draft`` against the cold floor script;
 - throughput: N clients asking for distinct draft spheres at once.
@@ -39,6 +42,7 @@ RESULTS = ROOT / "bench" / "results"
 FLOOR = ROOT / "bench" / "floor" / "floor.py"
 SIZE = 256
 TIMING = re.compile(r"total;dur=([\d.]+)")
+RENDER_TIMING = re.compile(r"render;dur=([\d.]+)")
 _unique = count(1)
 
 
@@ -84,8 +88,10 @@ def serve_in_process() -> None:
         print(json.dumps(times), flush=True)
 
 
-def http_miss(client, base: str, preset: str, quality: str) -> float:
-    """One render nobody asked for before: a fresh exposure makes a fresh cache key."""
+def http_miss(client, base: str, preset: str, quality: str,
+              server: list[tuple[float, float]] | None = None) -> float:
+    """One render nobody asked for before: a fresh exposure makes a fresh cache key.
+    ``server`` gets Server-Timing's (total, render) in seconds."""
     exposure = 1.0 + next(_unique) * 1e-6
     start = time.perf_counter()
     answer = client.get(f"{base}/v1/render", params={
@@ -93,6 +99,10 @@ def http_miss(client, base: str, preset: str, quality: str) -> float:
         "exposure": exposure})
     elapsed = time.perf_counter() - start
     answer.raise_for_status()
+    if server is not None:
+        timing = answer.headers["server-timing"]
+        server.append((float(TIMING.search(timing)[1]) / 1e3,
+                       float(RENDER_TIMING.search(timing)[1]) / 1e3))
     return elapsed
 
 
@@ -153,6 +163,7 @@ def measure(args) -> dict:
     items = [("in-process", p, "draft") for p in presets] + [("in-process", "sphere", "standard")]
     items += [("http-miss", p, "draft") for p in presets] + [("http-miss", "sphere", "standard")]
     samples: dict[str, list[list[float]]] = {"floor": []}
+    timings: dict[str, list[tuple[float, float]]] = {}
     hits_client, hits_server = [], []
     env = {"OPALINE_CALIBRATE": "0", "OPALINE_QUEUE_SIZE": "64", "OPALINE_DEADLINE_S": "60"}
     with LocalServer(workers=args.workers, env=env) as server, \
@@ -173,7 +184,8 @@ def measure(args) -> dict:
                     if kind == "in-process":
                         times += local.ask(f"{preset} {quality} 1")
                     else:
-                        times.append(http_miss(client, server.base, preset, quality))
+                        times.append(http_miss(client, server.base, preset, quality,
+                                               timings.setdefault(f"{preset} {quality}", [])))
                 samples["floor"].append(floors)
                 samples.setdefault(f"{kind} {preset} {quality}", []).append(times)
             client_round, server_round = [], []
@@ -191,13 +203,31 @@ def measure(args) -> dict:
     floor_s = median_of_rounds(samples["floor"])
     rows = [{"measure": key, "ms": 1e3 * median_of_rounds(r), "ratio": median_of_rounds(r) / floor_s}
             for key, r in samples.items() if key != "floor"]
-    return {"floor_ms": 1e3 * floor_s, "rows": rows,
+    return {"floor_ms": 1e3 * floor_s, "rows": rows, "http_split": http_split(samples, timings),
             "hit_client_ms": 1e3 * median_of_rounds(hits_client),
             "hit_server_ms": median_of_rounds(hits_server),
             "throughput": {"clients": args.clients, "workers": args.workers,
                            "images_per_s": rps, "floor_images_per_s": 1.0 / floor_s},
             "cold": cold(args.rounds), "rounds": args.rounds, "per_round": args.per_round,
             "load_average": [load_before, os.getloadavg()[0]]}
+
+
+def http_split(samples: dict[str, list[list[float]]],
+               timings: dict[str, list[tuple[float, float]]]) -> list[dict]:
+    """Each HTTP miss's median time cut into: the exchange (client, loopback, uvicorn, the
+    middleware before the route's first dependency), the route's own work, the hand-off
+    to and from the worker, and the render + encode (the in-process median of the same
+    image, measured in the same run)."""
+    rows = []
+    for key, found in timings.items():
+        client = statistics.median(t for r in samples[f"http-miss {key}"] for t in r)
+        inprocess = statistics.median(t for r in samples[f"in-process {key}"] for t in r)
+        total = statistics.median(t for t, _ in found)
+        render = statistics.median(r for _, r in found)
+        rows.append({"case": key, "client_ms": 1e3 * client, "exchange_ms": 1e3 * (client - total),
+                     "route_ms": 1e3 * (total - render), "handoff_ms": 1e3 * (render - inprocess),
+                     "render_ms": 1e3 * inprocess})
+    return rows
 
 
 def markdown(result: dict) -> str:
@@ -209,6 +239,14 @@ def markdown(result: dict) -> str:
     for row in result["rows"]:
         kind, preset, tier = row["measure"].split()
         lines.append(f"| {kind} | {preset} | {tier} | {row['ms']:.1f} | {row['ratio']:.2f} |")
+    lines += ["", "HTTP miss, where its time goes (ms; medians of every sample, so the parts "
+              "need not add up exactly):", "",
+              "| preset | tier | client | HTTP exchange | route | hand-off | render + encode |",
+              "|---|---|---|---|---|---|---|"]
+    for row in result["http_split"]:
+        preset, tier = row["case"].split()
+        lines.append(f"| {preset} | {tier} | {row['client_ms']:.1f} | {row['exchange_ms']:.2f} | "
+                     f"{row['route_ms']:.2f} | {row['handoff_ms']:.2f} | {row['render_ms']:.1f} |")
     cold_ = result["cold"]
     tp = result["throughput"]
     lines += ["", f"- cache hit: {result['hit_client_ms']:.2f} ms at the client, "

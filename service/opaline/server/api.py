@@ -191,7 +191,6 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
-    app.dependency_overrides[get_settings] = lambda: settings
     app.state.meshes = MeshStore(settings)
     install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
     app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)

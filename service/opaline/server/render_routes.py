@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Depends, Query, Request
+from fastapi import APIRouter, Depends, Request
 from fastapi.responses import Response
 
 from opaline.model.auto import auto_headers
@@ -36,6 +36,7 @@ from opaline.server.canonical import (
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, UnknownEnvironment
 from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
+from opaline.server.query_params import documented, query_model
 from opaline.server.service import Service, get_service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
@@ -188,19 +189,23 @@ async def render_post(started: Started, request: Request, svc: ServiceDep) -> Re
                                started)
 
 
+# The query strings are read by query_model (FastAPI's own reading of a Query() model cost
+# 0.2 ms a request); documented() lists their parameters as FastAPI would.
 @router.get("/v1/render", tags=["render"], response_class=Response,
-            responses={**RENDER_RESPONSES, **CONDITIONAL},
+            responses={**RENDER_RESPONSES, **CONDITIONAL}, openapi_extra=documented(CanonicalQuery),
             summary="Render a preset with material overrides (query string, for <img src>)")
-async def render_get(started: Started, params: Annotated[CanonicalQuery, Query()],
+async def render_get(started: Started,
+                     params: Annotated[CanonicalQuery, Depends(query_model(CanonicalQuery))],
                      request: Request, svc: ServiceDep) -> Response:
     return await answer_render(svc, request, params.request(), started)
 
 
 @router.get("/v1/mdf", tags=["render"], response_class=Response, responses=MDF_RESPONSES,
+            openapi_extra=documented(CanonicalMdfQuery),
             summary="Plot the MDF over the projected half-vector disc (Figs. 2, 3, 6, 7)")
-async def mdf_get(started: Started, query: Annotated[CanonicalMdfQuery, Query()],
-                  request: Request,
-                  svc: ServiceDep) -> Response:
+async def mdf_get(started: Started,
+                  query: Annotated[CanonicalMdfQuery, Depends(query_model(CanonicalMdfQuery))],
+                  request: Request, svc: ServiceDep) -> Response:
     params, canonical = canonical_plot(query.plot())
     check_mdf_limits(params, svc.settings)
     material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
