@@ -172,6 +172,30 @@ def plot_fields(pairs: list[str]) -> dict[str, Any]:
     return fields
 
 
+def add_source(parser: argparse.ArgumentParser, mesh_help: str) -> None:
+    """What render, turntable and export draw: a preset or material file, ``--set``
+    overrides, and ``--mesh``."""
+    parser.add_argument("source", metavar="PRESET|FILE",
+                        help="preset name (see `opaline presets`) or material file "
+                             "(.toml/.json, see `opaline schema`)")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a parameter; repeatable (albedo takes R,G,B)")
+    parser.add_argument("--mesh", metavar="FILE", help=mesh_help)
+
+
+def source_fields(args: argparse.Namespace) -> dict[str, Any]:
+    """``--set``, ``--mesh`` and, where the command has them, ``--size`` and ``--quality``
+    as request fields (the request model validates them)."""
+    fields = parse_sets(args.set)
+    if getattr(args, "size", None):
+        fields["width"], fields["height"] = parse_size(args.size)
+    if getattr(args, "quality", None):
+        fields["quality"] = args.quality
+    if args.mesh:
+        fields["mesh"] = args.mesh
+    return fields
+
+
 def add_common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--backend",

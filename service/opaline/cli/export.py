@@ -6,9 +6,15 @@ from __future__ import annotations
 import argparse
 import logging
 from pathlib import Path
-from typing import Any
 
-from opaline.cli.args import CliError, add_common, load_request, parse_sets, write_output
+from opaline.cli.args import (
+    CliError,
+    add_common,
+    add_source,
+    load_request,
+    source_fields,
+    write_output,
+)
 
 log = logging.getLogger("opaline.cli")
 KINDS = {".glsl": "glsl", ".frag": "glsl", ".glb": "glb"}
@@ -17,10 +23,7 @@ KINDS = {".glsl": "glsl", ".frag": "glsl", ".glb": "glb"}
 def cmd_export(args: argparse.Namespace) -> None:
     from opaline.local.export import export_material
 
-    fields: dict[str, Any] = parse_sets(args.set)
-    if args.mesh:
-        fields["mesh"] = args.mesh
-    request = load_request(args.source, fields)
+    request = load_request(args.source, source_fields(args))
     kind = KINDS.get(Path(args.output).suffix.lower())
     if kind is None:
         raise CliError(f"-o {args.output}: the name must end in .glsl, .frag or .glb")
@@ -45,10 +48,7 @@ def cmd_import(args: argparse.Namespace) -> None:
 def register(sub: argparse._SubParsersAction) -> None:
     export = sub.add_parser("export", help="a material as a GLSL function (.glsl) or as glTF "
                                            "with its mesh (.glb)")
-    export.add_argument("source", metavar="PRESET|FILE", help="preset name or material file")
-    export.add_argument("--mesh", metavar="FILE", help="export this mesh instead of the preset's")
-    export.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a parameter; repeatable")
+    add_source(export, "export this mesh instead of the preset's")
     export.add_argument("-o", "--output", required=True, metavar="FILE",
                         help="FILE.glsl (or .frag) or FILE.glb")
     add_common(export)

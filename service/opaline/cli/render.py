@@ -13,13 +13,14 @@ from pydantic import ValidationError
 from opaline.cli.args import (
     CliError,
     add_common,
+    add_source,
     load_request,
     output_format,
     parameter_help,
-    parse_sets,
     parse_size,
     plot_fields,
     plot_parameter_help,
+    source_fields,
     write_output,
 )
 from opaline.model.params import ImageFormat, Material, Quality, RenderFields, describe_errors
@@ -30,16 +31,10 @@ log = logging.getLogger("opaline.cli")
 def cmd_render(args: argparse.Namespace) -> None:
     from opaline.local.pipeline import LocalRenderer
 
-    fields: dict[str, Any] = parse_sets(args.set)
+    fields: dict[str, Any] = source_fields(args)
     wanted = args.format or fields.pop("format", None)  # --set format=X is --format X
-    if args.size:
-        fields["width"], fields["height"] = parse_size(args.size)
-    if args.quality:
-        fields["quality"] = args.quality
     if args.transparent:
         fields["transparent"] = True
-    if args.mesh:
-        fields["mesh"] = args.mesh
     request = load_request(args.source, fields)
     fmt = output_format(args.output, wanted, request.format)
     request = request.model_copy(update={"format": fmt})
@@ -92,11 +87,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     fmt = argparse.RawDescriptionHelpFormatter
     render = sub.add_parser("render", help="render a preset or a material file to an image",
                             epilog=parameter_help(), formatter_class=fmt)
-    render.add_argument("source", metavar="PRESET|FILE",
-                        help="preset name (see `opaline presets`) or material file "
-                             "(.toml/.json, see `opaline schema`)")
-    render.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a parameter; repeatable (albedo takes R,G,B)")
+    add_source(render, "draw this mesh (glTF/GLB, OBJ, PLY, STL) with the preset's lights "
+                       "and material; the camera frames it")
     render.add_argument("--size", metavar="WxH",
                         help="image size WxH or N (N×N), each 16 … 2048 (default 256x256)")
     render.add_argument("--format", choices=get_args(ImageFormat),
@@ -108,9 +100,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                              "neither is set)")
     render.add_argument("--transparent", action="store_true",
                         help="transparent PNG background")
-    render.add_argument("--mesh", metavar="FILE",
-                        help="draw this mesh (glTF/GLB, OBJ, PLY, STL) with the preset's lights "
-                             "and material; the camera frames it")
     add_output(render)
     add_common(render)
     render.set_defaults(func=cmd_render)

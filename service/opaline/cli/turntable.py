@@ -6,14 +6,13 @@ from __future__ import annotations
 import argparse
 import logging
 import time
-from typing import Any
 
 from opaline.cli.args import (
     CliError,
     add_common,
+    add_source,
     load_request,
-    parse_sets,
-    parse_size,
+    source_fields,
     write_output,
 )
 from opaline.model.params import Quality
@@ -27,14 +26,7 @@ def cmd_turntable(args: argparse.Namespace) -> None:
     from opaline.local.turntable import turntable_bytes
     from opaline.model.turntable import TurntableRequest
 
-    fields: dict[str, Any] = parse_sets(args.set)
-    if args.size:
-        fields["width"], fields["height"] = parse_size(args.size)
-    if args.quality:
-        fields["quality"] = args.quality
-    if args.mesh:
-        fields["mesh"] = args.mesh
-    base = load_request(args.source, fields)
+    base = load_request(args.source, source_fields(args))
     suffix = next((s for s in SUFFIXES if args.output.lower().endswith(s)), None)
     fmt = args.format or (SUFFIXES[suffix] if suffix else None)
     if fmt is None:
@@ -59,10 +51,7 @@ def cmd_turntable(args: argparse.Namespace) -> None:
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("turntable", help="render the object from every side: an animated "
                                               "WebP, GIF or MP4")
-    parser.add_argument("source", metavar="PRESET|FILE", help="preset name or material file")
-    parser.add_argument("--mesh", metavar="FILE", help="draw this mesh file instead")
-    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a parameter; repeatable")
+    add_source(parser, "draw this mesh file instead")
     parser.add_argument("--frames", type=int, default=36, help="frames in one turn (default 36)")
     parser.add_argument("--fps", type=int, default=24, help="frames per second (default 24)")
     parser.add_argument("--size", metavar="WxH", help="frame size (default 256x256)")
