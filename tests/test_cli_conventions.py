@@ -246,3 +246,14 @@ def test_cost_budget_from_the_environment(capsys, tmp_path, cost_budget):
     assert run(capsys, *argv)[0] == 0
     assert Image.open(tmp_path / "a.png").size == (32, 32)
 
+
+
+def test_an_invalid_setting_is_one_line_naming_the_variable(capsys, tmp_path, cost_budget):
+    """OPALINE_COST_BUDGET=abc ends as a usage error that names the variable, its value and
+    the rule, not as pydantic's traceback."""
+    cost_budget("abc")  # type: ignore[arg-type]
+    status, _, err = run(capsys, "render", "cd-rom", "--size", "32x32", "--quality", "draft",
+                         "-o", str(tmp_path / "a.png"))
+    line = one_line_error(status, err)
+    assert status == 2 and "OPALINE_COST_BUDGET='abc'" in line and "integer" in line, line
+    assert not (tmp_path / "a.png").exists()

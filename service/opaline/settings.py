@@ -42,12 +42,25 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+class SettingsError(ValueError):
+    """An ``OPALINE_*`` variable the settings refuse, said in one line."""
+
+
 @lru_cache
 def get_settings() -> Settings:
-    """The process's settings, read from the environment once."""
+    """The process's settings, read from the environment once. A variable the class
+    refuses raises ``SettingsError`` naming it, its value and the rule it breaks (the
+    command line prints that line instead of pydantic's traceback)."""
+    from pydantic import ValidationError
+
     from opaline.service_settings import Settings
 
-    return Settings()
+    try:
+        return Settings()
+    except ValidationError as exc:
+        problems = [f"{ENV_PREFIX.upper()}{'_'.join(map(str, error['loc'])).upper()}="
+                    f"{error.get('input')!r}: {error['msg']}" for error in exc.errors()]
+        raise SettingsError("; ".join(problems)) from None
 
 
 def setting(name: str) -> Any:

@@ -29,10 +29,11 @@ from opaline.model.request import CostError, resolve
 from opaline.resources import PRESETS_ENV, presets_dir
 from opaline.scene.environments import EnvironmentMapError
 from opaline.scene.meshfile import MeshError
+from opaline.settings import SettingsError
 
 log = logging.getLogger("opaline.cli")
 USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
-                EnvironmentMapError, MeshFileMissing)
+                EnvironmentMapError, MeshFileMissing, SettingsError)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
 USES_PRESETS = ("render", "presets", "batch", "gallery", "serve", "turntable", "export",
                 "import")
