@@ -15,6 +15,7 @@ from opaline.gl.culling import Culling
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
+from opaline.scene import closed
 from opaline.scene.closed import orientation
 from opaline.scene.geometry import annulus, box, sphere
 
@@ -54,6 +55,15 @@ def test_open_torn_or_inconsistent_meshes_are_not_closed():
     disc = annulus(0.2, 1.0, segments=64)
     assert orientation(disc.positions, disc.indices) == 0
     assert orientation(np.zeros((3, 3)), np.array([[0, 1, 2]])) == 0
+
+
+def test_meshes_over_the_limit_are_not_checked(monkeypatch):
+    """The check's memory grows with the triangles: past the limit a mesh is drawn two-sided."""
+    mesh = sphere(segments=48, rings=24)
+    monkeypatch.setattr(closed, "MAX_TRIANGLES", len(mesh.indices) - 1)
+    assert orientation(mesh.positions, mesh.indices) == 0
+    monkeypatch.setattr(closed, "MAX_TRIANGLES", len(mesh.indices))
+    assert orientation(mesh.positions, mesh.indices) == 1
 
 
 def test_culling_needs_a_closed_mesh_and_its_box_in_front_of_the_near_plane():
