@@ -119,3 +119,24 @@ def test_culled_renders_equal_two_sided_ones(renderer, monkeypatch, preset, fiel
     # better). A wrong decision (culling from inside, or the wrong winding) blanks areas.
     differs = np.any(pixels != two_sided, axis=-1)
     assert differs.sum() <= 4, np.argwhere(differs)
+
+
+@pytest.mark.gl
+def test_a_users_closed_mesh_is_culled_and_looks_the_same(local, monkeypatch, tmp_path):
+    """A torus from a .glb (UV seams: welding joins them) is found closed and culled."""
+    from mesh_helpers import mesh_bytes
+
+    path = tmp_path / "torus.glb"
+    path.write_bytes(mesh_bytes("glb"))
+    request = RenderRequest(preset="sphere", mesh=str(path), width=96, height=80,
+                            quality="draft", camera_azimuth=30.0, camera_elevation=25.0)
+    decisions = []
+    decide = Culling.front_face
+    monkeypatch.setattr(Culling, "front_face",
+                        lambda self, *args: decisions.append(decide(self, *args)) or decisions[-1])
+    culled = local.render_array(request)
+    assert decisions and decisions[-1] == "ccw"
+    monkeypatch.setattr(Culling, "front_face", lambda self, *args: None)
+    two_sided = local.render_array(request)
+    differs = np.any(np.abs(culled - two_sided) > 1e-6, axis=-1)
+    assert culled[..., 3].mean() > 0.1 and differs.sum() <= 4, np.argwhere(differs)
