@@ -57,6 +57,32 @@ def test_open_torn_or_inconsistent_meshes_are_not_closed():
     assert orientation(np.zeros((3, 3)), np.array([[0, 1, 2]])) == 0
 
 
+def shifted(mesh, offset: float, flip: bool = False):
+    """A half-size copy of the mesh moved along x (wound the other way if ``flip``): the
+    two parts' volumes do not cancel, so only a per-part check can tell."""
+    positions = 0.5 * mesh.positions + np.array([offset, 0.0, 0.0], dtype=np.float32)
+    return positions, mesh.indices[:, ::-1] if flip else mesh.indices
+
+
+def test_every_part_must_be_wound_the_same_way_out():
+    """Two spheres side by side are closed; with one of them turned inside out (a bad export)
+    each part is still closed and consistent, but culling would show the inside of its near
+    side, so the mesh is refused. A double-sided sheet (two faces back to back) is closed with
+    no volume: refused too."""
+    mesh = sphere(segments=32, rings=16)
+    n = len(mesh.positions)
+    for flip, expected in ((False, 1), (True, 0)):
+        second, indices = shifted(mesh, 3.0, flip)
+        positions = np.concatenate([mesh.positions, second])
+        assert orientation(positions, np.concatenate([mesh.indices, indices + n])) == expected
+    quad = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float32)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    sheet = np.concatenate([faces, faces[:, ::-1]])
+    assert orientation(quad, sheet) == 0
+    positions = np.concatenate([mesh.positions, quad + 3.0])
+    assert orientation(positions, np.concatenate([mesh.indices, sheet + n])) == 0
+
+
 def test_meshes_over_the_limit_are_not_checked(monkeypatch):
     """The check's memory grows with the triangles: past the limit a mesh is drawn two-sided."""
     mesh = sphere(segments=48, rings=24)
