@@ -30,8 +30,8 @@ def _welded_triangles(positions: np.ndarray, indices: np.ndarray) -> tuple[np.nd
     grid = np.round((positions - positions.min(axis=0)) * (WELD_STEPS / extent)).astype(np.int64)
     # One integer per grid point (21 bits an axis): a 1-D unique is far faster than rows'.
     keys = (grid[:, 0] << 42) | (grid[:, 1] << 21) | grid[:, 2]
-    # Equal keys, one id (np.unique would do, but its first call imports numpy.ma: 11 ms
-    # of a cold render).
+    # Equal keys, one id. (Not np.unique: without return_inverse it asks numpy.ma, whose
+    # import is 11 ms of a cold render; tests/test_cold_start.py keeps it out.)
     order = np.argsort(keys, kind="stable")
     ordered = keys[order]
     weld = np.empty(len(keys), dtype=np.int32)
