@@ -83,6 +83,29 @@ def test_every_part_must_be_wound_the_same_way_out():
     assert orientation(positions, np.concatenate([mesh.indices, sheet + n])) == 0
 
 
+def test_parts_touching_at_a_vertex_are_still_two_parts():
+    """A half-size sphere standing on the big one's pole (welded into one vertex): parts
+    are joined across edges, not vertices, so the small one turned inside out is found."""
+    mesh = sphere(segments=32, rings=16)
+    n = len(mesh.positions)
+    small = 0.5 * mesh.positions + np.array([0.0, 1.5, 0.0], dtype=np.float32)
+    positions = np.concatenate([mesh.positions, small])
+    for flip, expected in ((False, 1), (True, 0)):
+        indices = mesh.indices[:, ::-1] if flip else mesh.indices
+        assert orientation(positions, np.concatenate([mesh.indices, indices + n])) == expected
+
+
+def test_unused_vertices_neither_count_nor_cost():
+    """A file may carry vertices no triangle uses: far away, they must not widen the box
+    culling tests against the near plane, nor coarsen the weld."""
+    mesh = sphere(segments=32, rings=16)
+    far = np.concatenate([mesh.positions, np.full((1000, 3), 1e6, dtype=np.float32)])
+    assert orientation(far, mesh.indices) == 1
+    cull = Culling(far, mesh.indices)
+    assert cull.corners.max() == pytest.approx(1.0)
+    assert cull.front_face(np.eye(4), looking_down_z(3.4, 0.05)) == "ccw"
+
+
 def test_meshes_over_the_limit_are_not_checked(monkeypatch):
     """The check's memory grows with the triangles: past the limit a mesh is drawn two-sided."""
     mesh = sphere(segments=48, rings=24)

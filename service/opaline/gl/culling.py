@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from opaline.scene.closed import orientation
+from opaline.scene.closed import orientation, referenced
 
 
 class Culling:
@@ -26,7 +26,7 @@ class Culling:
         closed = self.sign != 0
         self.corners = np.zeros((8, 3))
         if closed:
-            points = np.asarray(positions, dtype=np.float64)
+            points, _ = referenced(positions, indices)  # not a file's unused vertices
             low, high = points.min(axis=0), points.max(axis=0)
             self.corners = np.array([[(low, high)[(i >> k) & 1][k] for k in range(3)]
                                      for i in range(8)])
