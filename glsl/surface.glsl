@@ -101,7 +101,9 @@ void main() {
     // the vertices: exact at any mesh density, so a thumbnail's mesh can be coarse.
     vec2 slope = wave_slope(v_object.xz);
     n = u_normal_matrix * vec3(-slope.x, 1.0, -slope.y);
+#ifndef TANGENT_CONCENTRIC
     t = mat3(u_model) * vec3(1.0, slope.x, 0.0);
+#endif
 #endif
 #ifdef NORMAL_MAP
     vec3 mapped = texture(u_normal_map, v_uv, u_lod_bias).xyz;

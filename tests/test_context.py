@@ -13,6 +13,7 @@ import pytest
 
 from opaline.gl import context, osmesa
 from opaline.gl.context import ContextError, create_context, pick_egl_device, requested_backend
+from opaline.settings import SettingsError
 
 ROOT = Path(__file__).resolve().parent.parent
 SOFTWARE = "EGL_MESA_device_software"
@@ -76,9 +77,12 @@ def test_requested_backend_reads_the_environment(monkeypatch):
     assert requested_backend("egl") == "egl"
     monkeypatch.setenv("OPALINE_GL_BACKEND", "Auto")
     assert requested_backend() == "auto"
+    # A bad variable is a settings error naming it (one line, exit 2 from the command).
     monkeypatch.setenv("OPALINE_GL_BACKEND", "bogus")
-    with pytest.raises(ContextError, match="bogus"):
+    with pytest.raises(SettingsError, match="OPALINE_GL_BACKEND='bogus': choose one of egl"):
         requested_backend()
+    with pytest.raises(ContextError, match="backend='bogus2' is not known"):
+        requested_backend("bogus2")
 
 
 def test_create_context_refuses_unknown_backend_first(monkeypatch):

@@ -35,15 +35,30 @@ def test_uniforms_give_the_heightfield_slope(name):
     np.testing.assert_allclose(sz, hz, atol=1e-12)
 
 
+def with_waves(name: str, waves, **geometry):
+    preset = get_preset(name)
+    args = {**preset.geometry.args, "waves": waves, **geometry}
+    return preset.model_copy(update={"geometry": Generator(kind="wavy", **args)})
+
+
 def test_only_wavy_sheets_of_up_to_eight_waves_are_analytic():
     assert heightfield.defines(get_preset("sphere")) == {}
-    many = get_preset("oil-slick")
-    args = {**many.geometry.args, "waves": [[0.01, 1.0, 10.0 * k, 0.0] for k in range(9)]}
-    many = many.model_copy(update={"geometry": Generator(kind="wavy", **args)})
-    assert not heightfield.analytic(many) and heightfield.uniforms(many) == {}
+    many = with_waves("oil-slick", [[0.01, 1.0, 10.0 * k, 0.0] for k in range(9)])
+    assert heightfield.defines(many) == {} and heightfield.uniforms(many) == {}
     # ...and then the thumbnail mesh is halved, as every other mesh is.
     assert scene_for_size(many, 256, 256).geometry.args["resolution"] == 96
     assert scene_for_size(get_preset("oil-slick"), 256, 256).geometry.args["resolution"] == 48
+
+
+def test_only_gentle_resolved_waves_get_the_quarter_mesh():
+    """Steep waves need the mesh's heights and outline, short ones its cells: half only."""
+    for name in ("oil-slick", "oil-slick-soft", "oil-film"):
+        assert heightfield.thumbnail_divisor(get_preset(name)) == 4, name
+    steep = with_waves("oil-slick", [[0.08, 0.3, 20.0, 0.0]])  # slope 1.7
+    short = with_waves("oil-slick", [[0.001, 0.3, 20.0, 0.0]])  # 3.5 cells of the quarter
+    for preset in (steep, short):
+        assert heightfield.thumbnail_divisor(preset) == 2
+        assert scene_for_size(preset, 256, 256).geometry.args["resolution"] == 96
 
 
 def linear(renderer, preset, **fields):
@@ -53,7 +68,7 @@ def linear(renderer, preset, **fields):
 
 
 @pytest.mark.gl
-@pytest.mark.parametrize("name", ["oil-slick", "oil-film"])
+@pytest.mark.parametrize("name", ["oil-slick", "oil-film", "oil-slick concentric"])
 def test_analytic_slope_on_a_coarse_mesh_matches_vertex_normals_on_a_fine_one(
         renderer, monkeypatch, name):
     """Against the mesh's own (float64) vertex normals on a fine mesh (256 vertices a side
@@ -61,7 +76,9 @@ def test_analytic_slope_on_a_coarse_mesh_matches_vertex_normals_on_a_fine_one(
     image, mean error under 0.5 % of the bright end (measured: 0.12 % on oil-slick, 0.02 %
     on oil-film); vertex normals on the same coarse mesh are at least twice as far
     (2.3 % and 0.05 %): the comparison can fail."""
-    preset = get_preset(name)
+    preset = get_preset(name.split()[0])
+    if name.endswith("concentric"):  # the tangent field is the preset's, not dP/dx
+        preset = preset.model_copy(update={"tangents": "concentric"})
     analytic = linear(renderer, preset)
     fine = preset.model_copy(update={"geometry": Generator(
         kind="wavy", **{**preset.geometry.args, "resolution": 1024})})
@@ -69,7 +86,7 @@ def test_analytic_slope_on_a_coarse_mesh_matches_vertex_normals_on_a_fine_one(
         kind="wavy", **{**preset.geometry.args, "resolution": 192})})
     for name_ in ("defines", "uniforms"):
         monkeypatch.setattr(heightfield, name_, lambda preset: {})
-    monkeypatch.setattr(heightfield, "analytic", lambda preset: True)  # same coarsening
+    monkeypatch.setattr(heightfield, "thumbnail_divisor", lambda preset: 4)  # same coarsening
     reference, interpolated = linear(renderer, fine), linear(renderer, coarse)
     scale = np.percentile(reference[..., :3], 99)
     error = np.abs(analytic - reference)[..., :3].mean() / scale

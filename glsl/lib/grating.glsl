@@ -28,8 +28,8 @@ uniform float u_grating_depth_nm;
 
 // J_m(x) by its power series (x/2)^m/m! · Σ_k (-x²/4)^k·m!/(k!(k+m)!), summed by
 // Horner from the last term: a fixed count, no early exit, so it unrolls into
-// multiply-adds. Truncation < 1e-9 of the sum for x ≤ 7 (depth ≤ 400 nm); fp32
-// cancellation among the terms loses < 1e-5 absolute there.
+// multiply-adds. Truncation < 1e-9 absolute for x ≤ 7 (depth ≤ 400 nm, λ ≥ 380 nm: x ≤
+// 6.6); fp32 cancellation among the terms loses < 1e-5 absolute there.
 float bessel_j(int m, float x) {
     float half_x = 0.5 * x;
     float lead = 1.0;

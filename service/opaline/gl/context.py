@@ -17,7 +17,7 @@ from functools import cache
 import moderngl
 
 from opaline.gl.osmesa import OSMesaLoader, OSMesaUnavailable
-from opaline.settings import BACKENDS, BackendName  # noqa: F401 (re-exported)
+from opaline.settings import BACKENDS, BackendName, SettingsError  # noqa: F401 (re-exported)
 
 GL_REQUIRE = 330
 
@@ -74,7 +74,11 @@ class GLContext:
 def requested_backend(explicit: str | None = None) -> str:
     name = (explicit or os.environ.get("OPALINE_GL_BACKEND") or "egl").strip().lower()
     if name not in BACKENDS:
-        raise ContextError(f"backend={name!r} is not known: choose one of {', '.join(BACKENDS)}")
+        choices = ", ".join(BACKENDS)
+        if not explicit:  # the variable's fault: said as every other bad OPALINE_* is
+            raise SettingsError(f"OPALINE_GL_BACKEND={os.environ['OPALINE_GL_BACKEND']!r}: "
+                                f"choose one of {choices}")
+        raise ContextError(f"backend={name!r} is not known: choose one of {choices}")
     return name
 
 

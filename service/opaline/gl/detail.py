@@ -7,7 +7,7 @@ generator's density arguments are halved (a quarter of the triangles): at
 256² a sphere segment still spans ~9 px and the silhouette is within 0.1 px
 of the true circle, and normals and tangents are interpolated per fragment as
 before. The wavy sheet, whose slope is computed per fragment (gl/heightfield.py),
-goes to a quarter. Larger images draw the preset as written.
+goes to a quarter when its waves are gentle. Larger images draw the preset as written.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def scene_for_size(preset: Preset, width: int, height: int) -> Preset:
         return preset
     parameters = inspect.signature(factory).parameters
     args = preset.geometry.args
-    divisor = heightfield.THUMBNAIL_DIVISOR if heightfield.analytic(preset) else 2
+    divisor = heightfield.thumbnail_divisor(preset)
     changed = {}
     for name in DENSITY_ARGS:
         if name in parameters:

@@ -4,21 +4,28 @@ uniforms, and the mesh density that is then enough.
 With vertex normals, a thumbnail of an oil slick needed the mesh fine: its bands follow
 the normal closely, and at half the preset's density they had already moved (FLIP 0.018
 against the full mesh at 256²). With the slope computed where it is shaded, the mesh
-only carries positions, which a swell of amplitude 0.02 barely lifts off a plane.
+only carries positions, which a gentle swell barely lifts off a plane: a thumbnail may
+then draw a quarter of the density. Steep or short waves (a user's preset may have any)
+still need the mesh for their heights, occlusion and outline, and keep the half.
 """
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from opaline.model.presets import Preset
-from opaline.scene.waves import DEFAULT_WAVES, check_waves
+from opaline.scene.waves import DEFAULT_WAVES, check_waves, wavy_surface
 
 MAX_WAVES = 8  # more (a preset may list any number) keep the mesh's normals
-# How much coarser a thumbnail's sheet may be than the preset's when its slope is
-# analytic (gl/detail.py halves every other mesh): a quarter of the density, a
-# sixteenth of the triangles.
-THUMBNAIL_DIVISOR = 4
+# A quarter of the density (a sixteenth of the triangles; gl/detail.py halves every
+# other mesh) where the waves are gentle: slopes summing to at most GENTLE_SLOPE, and
+# the shortest wave spanning at least CELLS_PER_WAVE cells of the coarse grid. The
+# oil presets' swells (slopes 0.13 in all, 10 cells) stay within FLIP 0.005 of the full
+# mesh; a wave of slope 1.7 moved 0.02 there, against 0.005 at half the density.
+GENTLE_SLOPE = 0.2
+CELLS_PER_WAVE = 8
 
 
 def _waves(preset: Preset) -> np.ndarray | None:
@@ -28,9 +35,19 @@ def _waves(preset: Preset) -> np.ndarray | None:
     return waves if 1 <= len(waves) <= MAX_WAVES else None
 
 
-def analytic(preset: Preset) -> bool:
-    """Whether this preset's surface is shaded with the heightfield's own slope."""
-    return _waves(preset) is not None
+def thumbnail_divisor(preset: Preset) -> int:
+    """By how much a thumbnail may divide this sheet's density arguments (2 or 4)."""
+    waves = _waves(preset)
+    if waves is None:
+        return 2
+    defaults = inspect.signature(wavy_surface).parameters
+    args = {name: preset.geometry.args.get(name, defaults[name].default)
+            for name in ("size", "resolution")}
+    cell = float(args["size"]) / max(int(args["resolution"]) // 4 - 1, 1)
+    amplitude, wavelength = np.abs(waves[:, 0]), waves[:, 1]
+    gentle = float((amplitude * 2.0 * np.pi / wavelength).sum()) <= GENTLE_SLOPE
+    resolved = float(wavelength.min()) >= CELLS_PER_WAVE * cell
+    return 4 if gentle and resolved else 2
 
 
 def defines(preset: Preset) -> dict[str, int | bool]:
