@@ -30,7 +30,8 @@ class Service:
 
 async def app_settings(request: Request) -> Settings:
     """The app's settings (``create_app``'s), or what a test put in place of ``get_settings``
-    in ``app.dependency_overrides``.
+    in ``app.dependency_overrides`` (called with no arguments: such an override may not
+    take dependencies of its own).
 
     Read here rather than through an override that ``create_app`` registers: while any
     override is registered, FastAPI rebuilds every dependency of every request from its
