@@ -112,6 +112,14 @@ def _check_generators(filename: str, preset: Preset) -> None:
 _assets: dict[str, tuple[Any, Any]] = {}
 
 
+def _map_args(generator: Generator) -> dict[str, Any]:
+    """A map generator's arguments; a file map's path is relative to the presets folder."""
+    args = generator.args
+    if generator.kind == "file":
+        args["path"] = str(presets_dir() / args.get("path", ""))
+    return args
+
+
 def build_assets(preset: Preset) -> tuple[Any, Any]:
     """The preset's mesh and normal map (or None), generated once per scene."""
     if preset.geometry.kind == "file":
@@ -122,10 +130,7 @@ def build_assets(preset: Preset) -> tuple[Any, Any]:
         mesh = geometry.build(preset.geometry.kind, **preset.geometry.args)
         normal_map = None
         if preset.normal_map is not None:
-            args = preset.normal_map.args
-            if preset.normal_map.kind == "file":
-                args["path"] = str(presets_dir() / args.get("path", ""))
-            normal_map = normalmaps.build(preset.normal_map.kind, **args)
+            normal_map = normalmaps.build(preset.normal_map.kind, **_map_args(preset.normal_map))
         _assets[key] = (mesh, normal_map)
     return _assets[key]
 
@@ -139,10 +144,7 @@ def build_thickness(preset: Preset) -> Any:
     if key not in _thickness:
         field = None
         if preset.thickness_map is not None:
-            args = preset.thickness_map.args
-            if preset.thickness_map.kind == "file":
-                args["path"] = str(presets_dir() / args.get("path", ""))
-            field = thickness.build(preset.thickness_map.kind, **args)
+            field = thickness.build(preset.thickness_map.kind, **_map_args(preset.thickness_map))
         _thickness[key] = field
     return _thickness[key]
 
