@@ -7,6 +7,7 @@ vertex arrays made for it along (GL reuses the names of released objects).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import moderngl
@@ -25,25 +26,12 @@ class Kept:
     _empty_vao: dict[int, moderngl.VertexArray]
 
     def targets(self, size: tuple[int, int]) -> Targets:
-        found = self._targets.get(size)
-        if found is None:
-            found = Targets(self.ctx, size)
-            if not self._targets.put(size, found, found.nbytes):
-                found.release()
-                raise ValueError(f"{size[0]}×{size[1]} targets exceed the renderer's "
-                                 f"budget of {self.budgets.target_bytes} bytes")
-        return found
+        return _kept(self._targets, size, lambda: Targets(self.ctx, size),
+                     f"{size[0]}×{size[1]} targets exceed", self.budgets.target_bytes)
 
     def scene(self, preset: Preset) -> SceneGPU:
-        key = preset.scene_key()
-        found = self._scenes.get(key)
-        if found is None:
-            found = SceneGPU(self.ctx, preset)
-            if not self._scenes.put(key, found, found.nbytes):
-                found.release()
-                raise ValueError(f"scene {preset.name} exceeds the renderer's budget of "
-                                 f"{self.budgets.scene_bytes} bytes")
-        return found
+        return _kept(self._scenes, preset.scene_key(), lambda: SceneGPU(self.ctx, preset),
+                     f"scene {preset.name} exceeds", self.budgets.scene_bytes)
 
     def cache_stats(self) -> dict[str, int]:
         """Sizes and evictions of what this renderer keeps (reported by render workers)."""
@@ -59,3 +47,16 @@ class Kept:
         vao = self._empty_vao.pop(program.glo, None)
         if vao is not None:
             vao.release()
+
+
+def _kept(kept: BudgetLRU[Any, Any], key: Any, make: Callable[[], Any], what: str,
+          budget: int) -> Any:
+    """``kept[key]``, made and kept if missing; released and refused if it alone is over
+    the budget."""
+    found = kept.get(key)
+    if found is None:
+        found = make()
+        if not kept.put(key, found, found.nbytes):
+            found.release()
+            raise ValueError(f"{what} the renderer's budget of {budget} bytes")
+    return found
