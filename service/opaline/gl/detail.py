@@ -12,8 +12,6 @@ goes to a quarter when its waves are gentle. Larger images draw the preset as wr
 
 from __future__ import annotations
 
-import inspect
-
 from opaline.gl import heightfield
 from opaline.model.presets import Generator, Preset
 from opaline.scene import geometry
@@ -27,19 +25,11 @@ def scene_for_size(preset: Preset, width: int, height: int) -> Preset:
     """``preset`` with its mesh at the density an image of this size needs."""
     if max(width, height) > THUMBNAIL:
         return preset
-    factory = geometry.KINDS.get(preset.geometry.kind)
-    if factory is None:
-        return preset
-    parameters = inspect.signature(factory).parameters
-    args = preset.geometry.args
+    full = geometry.arguments(preset.geometry.kind, preset.geometry.args)
     divisor = heightfield.thumbnail_divisor(preset)
-    changed = {}
-    for name in DENSITY_ARGS:
-        if name in parameters:
-            value = args.get(name, parameters[name].default)
-            if isinstance(value, int) and value > MIN_DENSITY:
-                changed[name] = max(value // divisor, MIN_DENSITY)
+    changed = {name: max(full[name] // divisor, MIN_DENSITY) for name in DENSITY_ARGS
+               if isinstance(full.get(name), int) and full[name] > MIN_DENSITY}
     if not changed:
         return preset
-    coarse = Generator(kind=preset.geometry.kind, **{**args, **changed})
+    coarse = Generator(kind=preset.geometry.kind, **{**preset.geometry.args, **changed})
     return preset.model_copy(update={"geometry": coarse})

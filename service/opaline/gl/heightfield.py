@@ -11,12 +11,11 @@ still need the mesh for their heights, occlusion and outline, and keep the half.
 
 from __future__ import annotations
 
-import inspect
-
 import numpy as np
 
 from opaline.model.presets import Preset
-from opaline.scene.waves import DEFAULT_WAVES, check_waves, wavy_surface
+from opaline.scene import geometry
+from opaline.scene.waves import check_waves
 
 MAX_WAVES = 8  # more (a preset may list any number) keep the mesh's normals
 # A quarter of the density (a sixteenth of the triangles; gl/detail.py halves every
@@ -28,21 +27,21 @@ GENTLE_SLOPE = 0.2
 CELLS_PER_WAVE = 8
 
 
-def _waves(preset: Preset) -> np.ndarray | None:
+def _sheet(preset: Preset) -> tuple[dict, np.ndarray] | None:
+    """The wavy sheet's arguments (defaults filled in) and its waves, if it is analytic."""
     if preset.geometry.kind != "wavy":
         return None
-    waves = check_waves(preset.geometry.args.get("waves", DEFAULT_WAVES))
-    return waves if 1 <= len(waves) <= MAX_WAVES else None
+    args = geometry.arguments("wavy", preset.geometry.args)
+    waves = check_waves(args["waves"])
+    return (args, waves) if 1 <= len(waves) <= MAX_WAVES else None
 
 
 def thumbnail_divisor(preset: Preset) -> int:
     """By how much a thumbnail may divide this sheet's density arguments (2 or 4)."""
-    waves = _waves(preset)
-    if waves is None:
+    sheet = _sheet(preset)
+    if sheet is None:
         return 2
-    defaults = inspect.signature(wavy_surface).parameters
-    args = {name: preset.geometry.args.get(name, defaults[name].default)
-            for name in ("size", "resolution")}
+    args, waves = sheet
     cell = float(args["size"]) / max(int(args["resolution"]) // 4 - 1, 1)
     amplitude, wavelength = np.abs(waves[:, 0]), waves[:, 1]
     gentle = float((amplitude * 2.0 * np.pi / wavelength).sum()) <= GENTLE_SLOPE
@@ -51,15 +50,15 @@ def thumbnail_divisor(preset: Preset) -> int:
 
 
 def defines(preset: Preset) -> dict[str, int | bool]:
-    waves = _waves(preset)
-    return {"WAVES": len(waves)} if waves is not None else {}
+    sheet = _sheet(preset)
+    return {"WAVES": len(sheet[1])} if sheet else {}
 
 
 def uniforms(preset: Preset) -> dict[str, object]:
-    waves = _waves(preset)
-    if waves is None:
+    sheet = _sheet(preset)
+    if sheet is None:
         return {}
-    amplitude, wavelength, direction, phase = waves.T
+    amplitude, wavelength, direction, phase = sheet[1].T
     k = 2.0 * np.pi / wavelength
     angle = np.radians(direction)
     rows = np.stack([k * np.cos(angle), k * np.sin(angle), amplitude, phase], axis=1)

@@ -8,8 +8,10 @@ the dispatch from a preset's name to a generator.
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Callable
+from functools import cache
 
 import numpy as np
 
@@ -17,7 +19,8 @@ from opaline.scene import generators
 from opaline.scene.mesh import Mesh, grid_indices, make_mesh
 from opaline.scene.waves import DEFAULT_WAVES, RESOLUTION, wave_height, wavy_surface
 
-__all__ = ["DEFAULT_WAVES", "KINDS", "Mesh", "RESOLUTION", "annulus", "box", "build", "sphere",
+__all__ = ["DEFAULT_WAVES", "KINDS", "Mesh", "RESOLUTION", "annulus", "arguments", "box",
+           "build", "sphere",
            "wave_height", "wavy_surface"]
 
 TWO_PI = 2.0 * math.pi
@@ -166,3 +169,16 @@ def build(kind: str, **args) -> Mesh:
     can pass on verbatim.
     """
     return generators.call("geometry", KINDS, kind, args)
+
+
+@cache
+def _parameters(kind: str) -> tuple[inspect.Parameter, ...]:
+    factory = KINDS.get(kind)
+    return tuple(inspect.signature(factory).parameters.values()) if factory else ()
+
+
+def arguments(kind: str, args: dict) -> dict:
+    """``args`` with the generator's defaults filled in, as ``build`` would call it (empty
+    for a kind that is not a generator here, such as a user's mesh file)."""
+    return {p.name: args.get(p.name, p.default) for p in _parameters(kind)
+            if p.name in args or p.default is not inspect.Parameter.empty}
