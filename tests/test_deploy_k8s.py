@@ -17,9 +17,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-from opaline.server.localproxy import TEMPLATE, nginx_binary
+from opaline.server.localproxy import TEMPLATE
 from opaline.server.service import Service
 from opaline.settings import Settings, memory_budget_bytes
+from test_deploy_nginx import need_nginx
 
 # In CI (the test extra installs it) a missing validator is a failure, not a skip.
 if os.environ.get("CI"):
@@ -137,10 +138,7 @@ def test_timeouts_cover_the_longest_wait():
 
 def test_the_cache_image_fills_in_a_config_nginx_accepts(tmp_path):
     """deploy/nginx/entrypoint.sh with upstreams and a backup: `nginx -t` accepts the result."""
-    if nginx_binary() is None:
-        if os.environ.get("CI"):
-            pytest.fail("nginx is missing: scripts/test installs it (OPALINE_EXTRA_DEBS)")
-        pytest.skip("nginx is not installed")
+    need_nginx()
     env = {**os.environ, "OPALINE_NGINX_PREFIX": str(tmp_path), "OPALINE_LISTEN": "127.0.0.1:9",
            "OPALINE_NGINX_TEMPLATE": str(TEMPLATE), "OPALINE_BACKUPS": "127.0.0.1:12",
            "OPALINE_UPSTREAMS": "127.0.0.1:10 127.0.0.1:11",
