@@ -34,9 +34,9 @@ import time
 from pathlib import Path
 
 from opaline.server.localserver import LocalServer
+from report import RESULTS, save  # bench/report.py: run from bench/, it is on the path
 
 ROOT = Path(__file__).resolve().parent.parent
-RESULTS = ROOT / "bench" / "results"
 SIZE = 256
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere")
@@ -162,9 +162,7 @@ def main() -> None:
                                     ["--server", server.base, "--jobs", str(jobs)], {}, args,
                                     salt))
     result["load_after"] = " ".join(f"{x:.2f}" for x in os.getloadavg())
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "batch_throughput.json").write_text(json.dumps(result, indent=2) + "\n")
-    (RESULTS / "batch_throughput.md").write_text(markdown(result))
+    save("batch_throughput", result, markdown(result), show=False)
     print(f"wrote {RESULTS / 'batch_throughput.md'}")
 
 

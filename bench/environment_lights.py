@@ -25,7 +25,7 @@ sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "service")]
 from metrics import all_metrics  # noqa: E402
 from opaline.local.pipeline import LocalRenderer  # noqa: E402
 from opaline.model.params import RenderRequest  # noqa: E402
-from opaline.output.files import write_atomic  # noqa: E402
+from report import save  # noqa: E402
 
 COUNTS = (1, 2, 4, 8, 16, 32, 64, 128)
 REFERENCE = 256
@@ -71,10 +71,7 @@ def main() -> None:
         lines.append(f"| {r['preset']} | {r['environment']} | {r['K']} | {r['ms']:.1f} | "
                      f"{r['ref_ms']:.1f} | {r['psnr_db']:.1f} | {r['de2000_mean']:.2f} | "
                      f"{r['de2000_p95']:.2f} | {r['flip']:.4f} |")
-    out = ROOT / "bench" / "results"
-    write_atomic(out / "environment_lights.md", ("\n".join(lines) + "\n").encode())
-    write_atomic(out / "environment_lights.json", json.dumps(rows, indent=1).encode())
-    print("\n".join(lines))
+    save("environment_lights", rows, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -11,13 +11,12 @@ default) is listed beside it, as the measurement behind the choice. Writes bench
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import time
 import zlib
-from pathlib import Path
 
-RESULTS = Path(__file__).resolve().parent / "results"
+from report import save  # bench/report.py: run from bench/, it is on the path
+
 FORMATS = ("png", "png-zlib1", "png-zlib6", "webp", "webp-lossless", "avif", "jpeg")
 
 
@@ -82,11 +81,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=9)
     args = parser.parse_args()
     rows = measure(args.repeats)
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "formats.json").write_text(json.dumps(rows, indent=2))
-    table = markdown(rows)
-    (RESULTS / "formats.md").write_text(table)
-    print(table)
+    save("formats", rows, markdown(rows))
 
 
 if __name__ == "__main__":

@@ -10,7 +10,6 @@ writes bench/results/mesh_cost.{md,json}.
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import sys
 import tempfile
@@ -24,7 +23,7 @@ from opaline.local.pipeline import LocalRenderer  # noqa: E402
 from opaline.local.turntable import turntable_bytes  # noqa: E402
 from opaline.model.params import RenderRequest  # noqa: E402
 from opaline.model.turntable import TurntableRequest  # noqa: E402
-from opaline.output.files import write_atomic  # noqa: E402
+from report import save  # noqa: E402
 
 
 def timed(local: LocalRenderer, request: RenderRequest, repeat: int) -> float:
@@ -64,10 +63,7 @@ def main() -> None:
              f".glb: {result['mesh_ms']:.1f} ms (ratio {result['ratio']:.2f})",
              *[f"- 36-frame turntable of cd-rom at 256², standard, {fmt}: {s:.2f} s"
                for fmt, s in turntables.items()]]
-    out = ROOT / "bench" / "results"
-    write_atomic(out / "mesh_cost.md", ("\n".join(lines) + "\n").encode())
-    write_atomic(out / "mesh_cost.json", json.dumps(result, indent=1).encode())
-    print("\n".join(lines))
+    save("mesh_cost", result, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

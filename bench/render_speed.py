@@ -15,9 +15,9 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-RESULTS = Path(__file__).resolve().parent / "results"
+from report import save  # bench/report.py: run from bench/, it is on the path
+
 SIZES = (256, 1024)
 
 
@@ -97,11 +97,7 @@ def main() -> None:
             text=True,
         )
         results.append(json.loads(out.stdout.strip().splitlines()[-1]))
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "render_speed.json").write_text(json.dumps(results, indent=2))
-    table = markdown(results, args.repeats)
-    (RESULTS / "render_speed.md").write_text(table)
-    print(table)
+    save("render_speed", results, markdown(results, args.repeats))
 
 
 if __name__ == "__main__":

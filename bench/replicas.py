@@ -37,9 +37,8 @@ from opaline.model.request import resolve
 from opaline.server.canonical import canonical_job, canonical_url
 from opaline.server.localproxy import LocalProxy
 from opaline.server.localserver import LocalServer
+from report import save  # bench/report.py: run from bench/, it is on the path
 
-ROOT = Path(__file__).resolve().parent.parent
-RESULTS = ROOT / "bench" / "results"
 ENV = {"OPALINE_QUEUE_SIZE": "256", "OPALINE_DEADLINE_S": "120", "OPALINE_CALIBRATE": "0"}
 
 
@@ -137,15 +136,12 @@ def main(argv: list[str] | None = None) -> int:
                           "platform": platform.platform()},
               "size": SIZE, "rows": rows, "ratios_vs_1_replica": ratios,
               "replica_peak_memory": memory}
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "replicas.json").write_text(json.dumps(result, indent=2) + "\n")
     text = (f"# Replicas behind nginx ({SIZE}², cd-rom, standard; {os.cpu_count()} cores)\n\n"
             f"`python bench/replicas.py --misses {args.misses} --hits {args.hits} "
             f"--concurrency {args.concurrency} --repeat {args.repeat}`\n\n{table(rows)}\n\n"
             f"Throughput against one replica asked directly: {json.dumps(ratios)}\n\n"
             f"Peak memory per replica (MiB): {json.dumps(memory)}\n")
-    (RESULTS / "replicas.md").write_text(text)
-    print(text)
+    save("replicas", result, text)
     return 0
 
 

@@ -37,8 +37,9 @@ from concurrent.futures import ThreadPoolExecutor
 from itertools import count
 from pathlib import Path
 
+from report import save  # bench/report.py: run from bench/, it is on the path
+
 ROOT = Path(__file__).resolve().parent.parent
-RESULTS = ROOT / "bench" / "results"
 FLOOR = ROOT / "bench" / "floor" / "floor.py"
 SIZE = 256
 TIMING = re.compile(r"total;dur=([\d.]+)")
@@ -272,11 +273,7 @@ def main() -> None:
         serve_in_process()
         return
     result = measure(args)
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "speed.json").write_text(json.dumps(result, indent=2))
-    table = markdown(result)
-    (RESULTS / "speed.md").write_text(table)
-    print(table)
+    save("speed", result, markdown(result))
 
 
 if __name__ == "__main__":

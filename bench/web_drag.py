@@ -12,13 +12,9 @@ bench/results/web_drag.json. tests/test_web.py uses ``drag_preview`` too.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-RESULTS = ROOT / "bench" / "results"
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
                  "--no-first-run", "--disable-background-networking",
@@ -103,8 +99,9 @@ def main() -> None:
     result = {"preset": args.preset, "seconds": seen["seconds"], "frames": seen["frames"],
               "updates_per_s": seen["frames"] / seen["seconds"], "max_in_flight": seen["max"],
               "requests": len(seen["urls"])}
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "web_drag.json").write_text(json.dumps(result, indent=2))
+    from report import save  # here: tests load this module without bench/ on the path
+
+    save("web_drag", result)
     print(f"{args.preset}, 256² draft while dragging: {result['updates_per_s']:.1f} updates/s "
           f"({seen['frames']} frames in {seen['seconds']:.1f} s, at most {seen['max']} in flight)")
 
