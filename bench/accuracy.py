@@ -87,10 +87,10 @@ OLD_DRAFT = (1, 0, "analytic")
 def time_tiers(bench: Bench, names: list[str]) -> dict[str, dict[str, float]]:
     """Per preset, each tier's (and the old draft's) time over draft's, in alternating pairs."""
     from opaline.model.presets import all_presets
-    from opaline.model.request import TIERS
+    from opaline.model.tiers import TIERS
 
     def point(tier: str) -> tuple:
-        return tuple(TIERS[tier][k] for k in ("samples", "wavelengths", "aa"))
+        return tuple(getattr(TIERS[tier], k) for k in ("samples", "wavelengths", "aa"))
 
     out = {}
     for name in names:

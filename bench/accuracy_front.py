@@ -30,13 +30,13 @@ def best_within(rows: list[dict], key: str, ms: float) -> float:
 
 
 def tier_point(rows: list[dict], tier: str) -> dict | None:
-    from opaline.model.request import TIERS
+    from opaline.model.tiers import TIERS
 
     want = TIERS[tier]
     # "analytic" compiles nothing for the Ashikhmin-Shirley MDF: its image is aa none's.
-    for aa in (want["aa"], "none"):
-        found = next((r for r in rows if r["samples"] == want["samples"]
-                      and r["wavelengths"] == want["wavelengths"] and r["aa"] == aa), None)
+    for aa in (want.aa, "none"):
+        found = next((r for r in rows if r["samples"] == want.samples
+                      and r["wavelengths"] == want.wavelengths and r["aa"] == aa), None)
         if found is not None:
             return found
     return None

@@ -27,12 +27,12 @@ from report import save  # noqa: E402
 
 
 def timed(local: LocalRenderer, request: RenderRequest, repeat: int) -> float:
-    job = local.job(request)
-    local.render_job(job)  # upload and compile
+    prepared = local.prepare(request)
+    local.produce(prepared)  # upload and compile
     times = []
     for _ in range(repeat):
         start = time.perf_counter()
-        local.render_job(job)
+        local.produce(prepared)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
 

@@ -43,8 +43,9 @@ def main() -> None:
     from opaline.gl.renderer import Renderer
     from opaline.model.params import RenderRequest
     from opaline.model.presets import get_preset
-    from opaline.model.request import TIERS, resolve
+    from opaline.model.request import resolve
     from opaline.model.spectrum import rotation_at, sample_wavelengths
+    from opaline.model.tiers import TIERS
 
     renderer = Renderer(None)
 
@@ -55,7 +56,7 @@ def main() -> None:
         return renderer.render(resolve(request, get_preset(preset))).display
 
     ref = TIERS["reference"]
-    s, w = int(ref["samples"]), int(ref["wavelengths"])
+    s, w = ref.samples, ref.wavelengths
     lines = [f"θ(λ) beyond the anchors, {args.size}², FLIP (`python bench/spectral_extremes.py`)",
              "", "| preset | θ1, θ2 | rule | θ span over 380-780 nm (rad) | 32 wl vs 128 wl, 1 spp "
              f"| reference ({s}×{w}) vs {2 * s}×{2 * w} |", "|---|---|---|---|---|---|"]

@@ -18,7 +18,8 @@ from bench_metrics import metrics
 from opaline.model import auto
 from opaline.model.params import RenderRequest
 from opaline.model.presets import all_presets, get_preset
-from opaline.model.request import TIERS, resolve
+from opaline.model.request import resolve
+from opaline.model.tiers import TIERS, Tier
 
 pytestmark = pytest.mark.gl
 pytest.importorskip("flip_evaluator")
@@ -52,13 +53,13 @@ def draw(renderer, preset: str, size: int, material: dict, **fields) -> np.ndarr
     return renderer.render(job, get_preset(preset)).display
 
 
-def table_ms(preset: str, setting: dict) -> float:
+def table_ms(preset: str, setting: Tier) -> float:
     points = auto.load_table()["presets"][preset]["points"]
     # "analytic" compiles nothing for the Ashikhmin-Shirley MDF: the table has aa none's.
-    for aa in (setting["aa"], "none"):
+    for aa in (setting.aa, "none"):
         for point in points:
             if (point["samples"], point["wavelengths"], point["aa"]) == (
-                    setting["samples"], setting["wavelengths"], aa):
+                    setting.samples, setting.wavelengths, aa):
                 return point["ms"]
     raise AssertionError(f"{setting} is not a measured point of {preset}")
 
@@ -121,7 +122,7 @@ def test_auto_meets_flip_005_and_is_no_slower_than_a_tier_that_does(renderer, co
                                 format="png16", **material)
         job = resolve(request, get_preset(preset))
         got = metrics.flip(reference, renderer.render(job, get_preset(preset)).display)
-        assert got <= TARGET, f"{material}: auto picked {job.auto}, FLIP {got:.4f}"
+        assert got <= TARGET, f"{material}: auto picked {job.tier}, FLIP {got:.4f}"
         assert cost(job) <= max(cost(j) for j in jobs.values()) == cost(jobs["reference"])
         if index == 0:
             image = renderer.render(jobs["reference"], get_preset(preset)).display
@@ -138,7 +139,7 @@ def test_reference_tier_is_converged_at_extreme_rotations(renderer, converged, p
     twice its wavelengths (96²). Without per-sample wavelength shifts, 32 wavelengths were 0.05
     to 0.08 away from 128."""
     material = {"theta1": theta1, "theta2": theta2}
-    doubled = (2 * TIERS["reference"]["samples"], 2 * TIERS["reference"]["wavelengths"])
+    doubled = (2 * TIERS["reference"].samples, 2 * TIERS["reference"].wavelengths)
     twice = converged(preset, material, 96, doubled)
     image = draw(renderer, preset, 96, material, quality="reference")
     assert metrics.flip(twice, image) <= 0.01

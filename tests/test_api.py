@@ -17,7 +17,7 @@ from PIL import Image
 
 from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
-from opaline.model.request import TIERS
+from opaline.model.tiers import TIERS
 from opaline.server.api import WEB_DIR, create_app, mount_web
 from opaline.server.errors import HTTP_REASONS, PUBLIC_ERRORS
 from opaline.server.metrics import REJECT_REASONS
@@ -307,7 +307,7 @@ def test_unknown_preset_is_404_listing_presets(client):
 def test_cost_over_budget_is_422_naming_the_budget(backend):
     """A request over the cost budget answers 422 whose message names the budget."""
     draft = TIERS["draft"]
-    budget = 64 * 64 * draft["samples"] * max(draft["wavelengths"], 3)  # one draft 64² image
+    budget = 64 * 64 * draft.samples * max(draft.wavelengths, 3)  # one draft 64² image
     with make_client(backend, cost_budget=budget) as client:
         assert client.get(f"/v1/render?{SMALL}").status_code == 200
         response = client.get("/v1/render?width=128&height=64&quality=draft")

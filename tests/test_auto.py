@@ -14,7 +14,8 @@ import pytest
 from opaline.model import auto
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import all_presets, get_preset
-from opaline.model.request import TIERS, resolve
+from opaline.model.request import resolve
+from opaline.model.tiers import TIERS, Tier
 from opaline.resources import sources_digest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -68,16 +69,21 @@ def table_with(flips: dict[str, list[float]], ms: list[float]) -> dict:
     return {"size": 128, "presets": {"p": {"points": points, "materials": materials}}}, material
 
 
+def fallback(tier: Tier) -> bool:
+    return tier.measured is not None and tier.measured.basis.startswith("fallback")
+
+
 def test_pick_is_the_fastest_point_meeting_the_target():
     table, material = table_with({"base": [0.2, 0.04, 0.03]}, [1.0, 3.0, 2.0])
     table["presets"]["p"]["points"][2]["wavelengths"] = 8  # (an RGB point needs the same θ)
     chosen = auto.pick("p", material, 128, 128, 1.0, 0.05, None, table)
-    assert chosen.samples == 4 and chosen.flip == 0.03  # 2 ms beats 3 ms, both meet 0.05
-    assert "measured" in chosen.basis
+    assert chosen.samples == 4 and chosen.measured.flip == 0.03  # 2 ms beats 3 ms, both meet 0.05
+    assert "measured" in chosen.measured.basis
     strict = auto.pick("p", material, 128, 128, 1.0, 0.035, None, table)
     assert strict.samples == 4
     tight = auto.pick("p", material, 128, 128, 1.0, 0.01, None, table)
-    assert tight.basis.startswith("fallback") and tight.samples == TIERS["reference"]["samples"]
+    assert tight.measured.basis.startswith("fallback")
+    assert tight.samples == TIERS["reference"].samples
 
 
 def test_pick_judges_on_every_measured_material_at_the_nearest_span():
@@ -89,19 +95,19 @@ def test_pick_judges_on_every_measured_material_at_the_nearest_span():
                                   "wide": [0.3, 0.3, 0.3], "fine-wide": [0.5, 0.5, 0.5]},
                                  [1.0, 2.0, 3.0])
     own = auto.pick("p", material, 128, 128, 1.0, 0.05, None, table)
-    assert own.samples == 1 and own.basis == "measured on p (base)"
+    assert own.samples == 1 and own.measured.basis == "measured on p (base)"
     assert auto.pick("p", material, 512, 256, 1.0, 0.05, None, table).samples == 1
     harder = material.model_copy(update={"mu_f": 15.0})
     chosen = auto.pick("p", harder, 128, 128, 1.0, 0.05, None, table)
-    assert chosen.samples == 4 and chosen.basis == "measured on p (base+fine)"
+    assert chosen.samples == 4 and chosen.measured.basis == "measured on p (base+fine)"
     assert 0.04 > auto.MARGIN * 0.05  # so the 0.04 point was passed over for the margin
     turned = material.model_copy(update={"theta1": -3.0})  # a wider span: the wide ones
-    assert auto.pick("p", turned, 128, 128, 1.0, 0.05, None, table).basis.startswith("fallback")
+    assert fallback(auto.pick("p", turned, 128, 128, 1.0, 0.05, None, table))
     beyond = material.model_copy(update={"mu_f": 30.0})  # past fine's rate
-    assert auto.pick("p", beyond, 128, 128, 1.0, 0.05, None, table).basis.startswith("fallback")
-    assert auto.pick("p", material, 64, 64, 1.0, 0.05, None, table).basis.startswith("fallback")
+    assert fallback(auto.pick("p", beyond, 128, 128, 1.0, 0.05, None, table))
+    assert fallback(auto.pick("p", material, 64, 64, 1.0, 0.05, None, table))
     unknown = auto.pick("nowhere", material, 128, 128, 1.0, 0.05, None, table)
-    assert unknown.basis.startswith("fallback")
+    assert fallback(unknown)
 
 
 def test_rgb_points_need_the_measured_rotations():
@@ -112,7 +118,7 @@ def test_rgb_points_need_the_measured_rotations():
     assert auto.pick("p", material, 128, 128, 1.0, 0.05, None, table).wavelengths == 0
     turned = material.model_copy(update={"theta1": 0.05})  # a smaller span: dominated
     chosen = auto.pick("p", turned, 128, 128, 1.0, 0.05, None, table)
-    assert chosen.wavelengths == 8 and "measured" in chosen.basis
+    assert chosen.wavelengths == 8 and "measured" in chosen.measured.basis
 
 
 def test_delta_e_budget_is_met_too():
@@ -126,10 +132,10 @@ def test_a_budget_asks_for_auto_and_resolves_to_a_measured_setting():
     """max_flip without a quality means quality=auto; the job records the pick, and the
     headers and the CLI line say what it is."""
     job = resolve(RenderRequest(preset="cd-rom", max_flip=0.05, width=128, height=128))
-    assert job.quality == "auto" and job.auto is not None
-    assert "measured" in job.auto.basis and job.auto.flip <= 0.05
-    assert (job.samples, job.wavelengths, job.aa) == (job.auto.samples, job.auto.wavelengths,
-                                                      job.auto.aa)
+    assert job.quality == "auto" and job.tier.measured is not None
+    assert "measured" in job.tier.measured.basis and job.tier.measured.flip <= 0.05
+    assert (job.samples, job.wavelengths, job.aa) == (job.tier.samples, job.tier.wavelengths,
+                                                      job.tier.aa)
     headers = auto.auto_headers(job)
     assert headers["X-Opaline-Auto-Target"] == "max_flip=0.05"
     assert headers["X-Opaline-Auto-Setting"] == (
@@ -143,7 +149,7 @@ def test_a_budget_asks_for_auto_and_resolves_to_a_measured_setting():
 
 def test_auto_without_a_budget_aims_at_flip_005():
     job = resolve(RenderRequest(preset="nacre", quality="auto"))
-    assert job.auto.max_flip == auto.DEFAULT_MAX_FLIP == 0.05
+    assert job.tier.measured.max_flip == auto.DEFAULT_MAX_FLIP == 0.05
 
 
 def test_a_budget_with_a_tier_is_refused_naming_the_field():

@@ -229,10 +229,10 @@ def test_mdf_refuses_non_integer_wavelengths(capsys, tmp_path):
 
 
 def failing_render(monkeypatch):
-    def boom(self, job):
+    def boom(self, prepared):
         raise ShaderError("surface.glsl {} failed to compile: test")
 
-    monkeypatch.setattr("opaline.local.pipeline.LocalRenderer.render_job", boom)
+    monkeypatch.setattr("opaline.local.pipeline.LocalRenderer.produce", boom)
 
 
 def failing_replace(monkeypatch):

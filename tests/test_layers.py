@@ -21,9 +21,12 @@ RANKS = {
     "opaline.scene": 1,
     "opaline.model": 2,
     "opaline.gl": 3, "opaline.output": 3,
-    "opaline.local": 4, "opaline.workers": 4,
-    "opaline.server": 5, "opaline.batch": 5,
-    "opaline.cli": 6,
+    # Every entry point's one path (prepare, produce): above the model and the encoders,
+    # below every caller; GL-free (checked below), so the HTTP process can prepare.
+    "opaline.pipeline": 4,
+    "opaline.local": 5, "opaline.workers": 5,
+    "opaline.server": 6, "opaline.batch": 6,
+    "opaline.cli": 7,
 }
 # The package's own __init__ and __main__ lazily import the public API from the top:
 # their own imports are exempt from both checks. Importing those lazy names from the
@@ -126,6 +129,8 @@ def upward_imports(edges: dict[str, set[str]]) -> list[str]:
                 wrong.append(f"{module} (rank {RANKS[src]}) imports {target} (rank {RANKS[dst]})")
             elif src != dst and {src, dst} == {"opaline.server", "opaline.batch"}:
                 wrong.append(f"{module} imports {target}: server and batch are siblings")
+            elif (src, dst) == ("opaline.pipeline", "opaline.gl"):
+                wrong.append(f"{module} imports {target}: the pipeline prepares without GL")
     return wrong
 
 
@@ -151,7 +156,8 @@ def test_no_import_cycles():
 
 
 def test_no_lower_layer_imports_a_higher_one():
-    """settings/resources < scene < model < gl, output < local < server | batch < cli."""
+    """settings/resources < scene < model < gl, output < pipeline < local, workers
+    < server | batch < cli."""
     wrong = upward_imports(graph())
     assert not wrong, "\n".join(wrong)
 
@@ -168,11 +174,14 @@ def test_modules_stay_small():
 
 
 def test_the_checks_catch_what_they_claim():
-    """A cycle, an upward import and a server-batch import are each reported."""
+    """A cycle, an upward import, a server-batch import and GL in the pipeline are each
+    reported."""
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
     assert upward_imports({"opaline.model.params": {"opaline.gl.renderer"}})
     assert upward_imports({"opaline.server.api": {"opaline.batch.run"}})
+    assert upward_imports({"opaline.pipeline.produce": {"opaline.gl.renderer"}})
+    assert not upward_imports({"opaline.pipeline.produce": {"opaline.output.encode"}})
     assert not upward_imports({"opaline.gl.renderer": {"opaline"}})  # __version__
     lazy = ast.parse("def f():\n    from opaline import render\n")
     assert "opaline.local.api" in imports_from_tree(lazy, "opaline.model.params", modules())

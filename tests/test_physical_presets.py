@@ -10,7 +10,8 @@ from PIL import Image
 
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
-from opaline.model.request import TIERS, resolve
+from opaline.model.request import resolve
+from opaline.model.tiers import TIERS
 from opaline.scene import thickness
 
 PHYSICAL = ["oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film"]

@@ -13,7 +13,8 @@ import pytest
 
 from opaline.model.params import MATERIAL_FIELDS, RenderFields, RenderRequest
 from opaline.model.presets import get_preset
-from opaline.model.request import TIERS, CostError, Job, check_cost, resolve
+from opaline.model.request import CostError, Job, check_cost, resolve
+from opaline.model.tiers import TIERS
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -71,15 +72,15 @@ def test_tier_fills_samples_wavelengths_aa(tier):
     job = resolve(RenderRequest(quality=tier), custom_preset())
     assert job.quality == tier
     assert (job.samples, job.wavelengths, job.aa) == (
-        TIERS[tier]["samples"], TIERS[tier]["wavelengths"], TIERS[tier]["aa"])
+        TIERS[tier].samples, TIERS[tier].wavelengths, TIERS[tier].aa)
 
 
 def test_tiers_are_ordered():
     """Tiers are the four of docs/design.md §8, samples growing toward a spectral reference."""
     assert list(TIERS) == ["draft", "standard", "high", "reference"]
-    samples = [TIERS[t]["samples"] for t in TIERS]
+    samples = [TIERS[t].samples for t in TIERS]
     assert samples == sorted(samples) and samples[0] < samples[-1]
-    assert TIERS["reference"]["wavelengths"] >= 3
+    assert TIERS["reference"].wavelengths >= 3
 
 
 def test_explicit_fields_override_the_tier():
@@ -181,12 +182,13 @@ def test_cache_key_changes_with_preset():
 
 
 def test_canonical_form_is_json():
-    """The canonical form serialises to JSON with every Job field (a tier job has no auto
-    pick, and leaves the field out so its key stays what it was before quality=auto)."""
+    """The canonical form serialises to JSON with every Job field, the tier as its name (a
+    tier job has no auto pick, and leaves it out so its key stays what it was before
+    quality=auto)."""
+    fields = {f.name for f in dataclasses.fields(Job)} - {"tier"} | {"quality"}
     job = resolve(RenderRequest(preset="nacre"))
     data = json.loads(json.dumps(job.canonical()))
-    assert set(data) == {f.name for f in dataclasses.fields(Job)} - {"auto"}
+    assert set(data) == fields and data["quality"] == "standard"
     picked = resolve(RenderRequest(preset="nacre", quality="auto"))
-    assert set(json.loads(json.dumps(picked.canonical()))) == {
-        f.name for f in dataclasses.fields(Job)}
+    assert set(json.loads(json.dumps(picked.canonical()))) == fields | {"auto"}
     assert data["material"]["mu_f"] == job.material.mu_f

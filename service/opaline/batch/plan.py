@@ -15,12 +15,16 @@ from pathlib import Path
 from typing import Any
 
 from opaline import __version__
+from opaline.local.context import local_context
 from opaline.model.material_file import at, locate
 from opaline.model.materials import Item
-from opaline.model.presets import UnknownPreset, get_preset
-from opaline.model.request import CostError, Job, check_cost, resolve
+from opaline.model.meshes import MeshFileMissing
+from opaline.model.presets import UnknownPreset
+from opaline.model.request import CostError, Job
 from opaline.output.encode import EXTENSIONS
 from opaline.output.files import write_atomic
+from opaline.pipeline.limits import LimitError
+from opaline.pipeline.prepare import Context, Prepared, UnknownEnvironment, prepare
 
 WRITTEN = ("rendered", "skipped")  # the statuses with an output on disk
 
@@ -30,12 +34,16 @@ class Task:
     """One item's fate: where it goes, its key, and what happened."""
 
     item: Item
-    job: Job | None = None
+    prepared: Prepared | None = None
     key: str | None = None
     output: Path | None = None
     status: str = "pending"  # → rendered | skipped | failed | interrupted
     seconds: float = 0.0
     error: str | None = None
+
+    @property
+    def job(self) -> Job | None:
+        return None if self.prepared is None else self.prepared.job
 
     @property
     def sidecar(self) -> Path:
@@ -54,28 +62,27 @@ class Task:
 
 
 def plan(items: list[Item], out: Path, *, force: bool = False,
-         cost_budget: int | None = None) -> list[Task]:
-    """A task per item; ``cost_budget=None`` leaves the cost check to the server that renders."""
-    return [plan_one(item, out, force, cost_budget) for item in items]
+         cost_budget: int | None = None, context: Context | None = None) -> list[Task]:
+    """A task per item, prepared against ``context`` (default: this machine's, with
+    ``cost_budget``; ``None`` leaves the cost check to the server that renders)."""
+    context = context or local_context(cost_budget)
+    return [plan_one(item, out, force, context) for item in items]
 
 
-def plan_one(item: Item, out: Path, force: bool, cost_budget: int | None) -> Task:
+def plan_one(item: Item, out: Path, force: bool, context: Context) -> Task:
     task = Task(item)
     if item.request is None:
         task.status, task.error = "failed", item.error
         return task
     try:
-        preset = get_preset(item.request.preset)
-        task.job = resolve(item.request, preset)
-        if cost_budget is not None:
-            check_cost(task.job, cost_budget)
-    except (UnknownPreset, CostError) as exc:
+        task.prepared = prepare(item.request, context)
+    except (UnknownPreset, CostError, LimitError, UnknownEnvironment, MeshFileMissing) as exc:
         if isinstance(exc, UnknownPreset) and item.file == item.source:  # a material file
             item.line = locate(item.file, "preset")
         task.status, task.error = "failed", f"{at(item.source, item.line)}: {exc}"
         return task
-    task.key = task.job.cache_key(preset.scene_key())
-    task.output = out / (item.name + EXTENSIONS[task.job.format])
+    task.key = task.prepared.key
+    task.output = out / (item.name + EXTENSIONS[task.prepared.job.format])
     if not force and up_to_date(task):
         task.status = "skipped"
     return task

@@ -50,11 +50,10 @@ class GLProcesses:
         self.pool.start()
 
     def submit(self, task: Task) -> Future:
-        from opaline.model.presets import get_preset
-
         outcome: Future = Future()
+        assert task.prepared is not None and task.key is not None  # only planned tasks run
         try:
-            job = self.pool.submit(task.key, ImageTask(task.job, get_preset(task.job.preset)))
+            job = self.pool.submit(task.key, ImageTask(task.prepared))
         except Exception as exc:  # no worker has a context: the item fails with the reason
             outcome.set_result((None, 0.0, f"{type(exc).__name__}: {exc}"))
             return outcome

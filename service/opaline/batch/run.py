@@ -29,8 +29,11 @@ from opaline.batch.pool import start_pool
 from opaline.batch.progress import PlainProgress, make_progress
 from opaline.batch.shard import select
 from opaline.batch.sheet import write_contact_sheet
+from opaline.local.context import local_context
 from opaline.model.materials import Item, collect
 from opaline.output.files import write_atomic
+from opaline.pipeline.limits import Limits
+from opaline.pipeline.prepare import Context
 from opaline.settings import setting
 
 
@@ -66,11 +69,9 @@ def run_batch(inputs: list[str | Path], options: Options,
     if not items:
         shown = ", ".join(map(str, inputs))
         raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
-    # With --server the server checks the cost, against its own budget.
-    budget = None if options.server else setting("cost_budget")
     # Every shard prunes against all items: the others' outputs are not "gone".
     tasks = plan(select(items, options.shard), options.out, force=options.force,
-                 cost_budget=budget)
+                 context=batch_context(options))
     progress = progress or make_progress(options.quiet)
     progress.start(tasks)
     try:
@@ -91,6 +92,16 @@ def run_batch(inputs: list[str | Path], options: Options,
     if options.sheet:
         write_contact_sheet(options.out, tasks)
     return summary
+
+
+def batch_context(options: Options) -> Context:
+    """With --server the server checks the cost, against its own budget, and finds the
+    meshes (an upload's id or a file of its meshes folder): the plan keys the preset's own
+    scene. Without, this machine's settings and mesh files."""
+    if options.server:
+        return Context(Limits(cost_budget=None), meshes=lambda request, preset: preset,
+                       check_environments=False)
+    return local_context(setting("cost_budget"))
 
 
 def render_all(tasks: list[Task], options: Options, progress: PlainProgress) -> None:

@@ -39,16 +39,17 @@ def cmd_render(args: argparse.Namespace) -> None:
     fmt = output_format(args.output, wanted, request.format)
     request = request.model_copy(update={"format": fmt})
     with LocalRenderer(args.backend) as renderer:
-        job = renderer.job(request)
+        prepared = renderer.prepare(request)
+        job = prepared.job
         log.info("preset=%s %dx%d %s quality=%s samples=%d wavelengths=%d aa=%s cost=%d",
                  job.preset, job.width, job.height, job.format, job.quality, job.samples,
                  job.wavelengths, job.aa, job.cost)
-        if job.auto is not None:
+        if job.tier.measured is not None:
             from opaline.model.auto import describe
 
             log.info("quality=auto picked: %s", describe(job))
         started = time.perf_counter()
-        data = renderer.render_job(job)
+        data = renderer.produce(prepared)
         log.info("rendered in %.3f s (%d bytes)", time.perf_counter() - started, len(data))
     write_output(args.output, data)
     log.info("wrote %s", "stdout" if args.output == "-" else args.output)

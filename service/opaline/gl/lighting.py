@@ -2,9 +2,8 @@
 environment turned into K directional lights (``scene.environments``).
 
 K is a quality knob like samples and wavelengths: the job's
-``environment_lights`` if it sets one, else its tier's (chosen from the
-time/error points in docs/accuracy.md). An environment replaces the preset's
-lights; the preset's ambient term stays.
+``environment_lights`` if it sets one, else its tier's (``Job.environment_count``).
+An environment replaces the preset's lights; the preset's ambient term stays.
 """
 
 from __future__ import annotations
@@ -15,21 +14,12 @@ from opaline.model.request import Job
 from opaline.scene.environments import environment_lights
 from opaline.settings import setting
 
-# From bench/results/environment_lights.md (256², against K=256): each light costs about
-# as much as the rest of the shading, and ΔE00 mean falls from 2-4 (K=8) through 1-2.3
-# (16) and 0.6-1.6 (32) to 0.35-1 (64).
-ENVIRONMENT_LIGHTS = {"draft": 8, "standard": 16, "high": 32, "reference": 64}
-
-
-def environment_count(job: Job) -> int:
-    return job.environment_lights or ENVIRONMENT_LIGHTS[job.quality]
-
 
 def light_uniforms(job: Job, preset: Preset) -> dict[str, list[tuple]]:
     """``u_light_position`` (xyz and w: 1 point, 0 directional) and ``u_light_irradiance``."""
     if job.environment:
         direction, irradiance = environment_lights(
-            job.environment, environment_count(job), job.environment_rotation or 0.0,
+            job.environment, job.environment_count, job.environment_rotation or 0.0,
             1.0 if job.environment_intensity is None else job.environment_intensity,
             setting("environments_dir"))
         return {"u_light_position": [(*map(float, d), 0.0) for d in direction],

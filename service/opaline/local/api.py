@@ -26,7 +26,6 @@ from pydantic import ValidationError
 
 from opaline.local.pipeline import LocalRenderer
 from opaline.model.params import RenderRequest, describe_errors
-from opaline.model.request import Job
 from opaline.settings import BackendName
 
 # A request model, its fields as a mapping, or the path of a material file (.toml/.json).
@@ -94,11 +93,6 @@ def render_array(
 ) -> npt.NDArray[np.float32]:
     """Linear, premultiplied RGBA float32 of shape (height, width, 4)."""
     return renderer(backend).render_array(as_request(request))
-
-
-def render_job(job: Job, *, backend: BackendName | None = None) -> bytes:
-    """Encoded bytes for a job already resolved (``request.resolve``), as in ``opaline batch``."""
-    return renderer(backend).render_job(job)
 
 
 def close() -> None:

@@ -13,12 +13,10 @@ from pathlib import Path
 from typing import Any, Literal
 
 from opaline.gl.export_glsl import export_glsl
-from opaline.model.meshes import file_mesh_preset
+from opaline.local.context import local_context
 from opaline.model.params import RenderRequest
-from opaline.model.presets import get_preset
-from opaline.model.request import resolve
 from opaline.output.gltf import export_preset_glb, import_glb
-from opaline.settings import setting
+from opaline.pipeline.prepare import prepare
 
 ExportKind = Literal["glsl", "glb"]
 
@@ -27,10 +25,8 @@ def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind
     """GLSL source (UTF-8) or .glb bytes of the request's material (and, for .glb, mesh)."""
     if not isinstance(request, RenderRequest):
         request = RenderRequest.model_validate(dict(request))
-    preset = get_preset(request.preset)
-    if request.mesh is not None:
-        preset = file_mesh_preset(preset, request, setting("mesh_max_triangles"))
-    job = resolve(request, preset)
+    prepared = prepare(request, local_context(cost_budget=None))
+    preset, job = prepared.preset, prepared.job
     if kind == "glsl":
         return export_glsl(job.material, job.wavelengths).encode()
     return export_preset_glb(preset, job.material, job.wavelengths)

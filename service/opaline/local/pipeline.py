@@ -14,11 +14,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from opaline.gl.renderer import Renderer
-from opaline.model.meshes import file_mesh_preset
+from opaline.local.context import local_context
 from opaline.model.params import Material, RenderRequest
-from opaline.model.presets import Preset, get_preset
-from opaline.model.request import Job, check_cost, check_plot_cost, resolve
-from opaline.output.encode import encode_frame, encode_mdf
+from opaline.model.request import Job, check_plot_cost
+from opaline.output.encode import encode_mdf
+from opaline.pipeline.prepare import Prepared, prepare
+from opaline.pipeline.produce import produce
 from opaline.settings import setting
 
 
@@ -49,37 +50,23 @@ class LocalRenderer:
     def close(self) -> None:
         self.renderer.release()
 
-    @property
-    def mesh_presets(self) -> dict[str, Preset]:
-        """Presets made for mesh files: jobs name their preset, and these are in no folder
-        (made on first use, so subclasses that skip ``__init__`` still have one)."""
-        return self.__dict__.setdefault("_mesh_presets", {})
+    def prepare(self, request: RenderRequest) -> Prepared:
+        return prepare(request, local_context(self.budget))
 
-    def preset(self, request: RenderRequest) -> Preset:
-        """The request's preset, drawing the request's mesh file if it names one."""
-        preset = get_preset(request.preset)
-        if request.mesh is None:
-            return preset
-        preset = file_mesh_preset(preset, request, setting("mesh_max_triangles"))
-        self.mesh_presets[preset.name] = preset
-        return preset
+    def produce(self, prepared: Prepared) -> bytes:
+        return produce(prepared, self.renderer)
 
     def job(self, request: RenderRequest) -> Job:
-        job = resolve(request, self.preset(request))
-        check_cost(job, self.budget)
-        return job
-
-    def render_job(self, job: Job) -> bytes:
-        frame = self.renderer.render(job, self.mesh_presets.get(job.preset))
-        return encode_frame(frame, job.format, alpha=job.transparent)
+        return self.prepare(request).job
 
     def render_bytes(self, request: RenderRequest) -> bytes:
-        return self.render_job(self.job(request))
+        return self.produce(self.prepare(request))
 
     def render_array(self, request: RenderRequest) -> np.ndarray:
         """Linear, premultiplied RGBA float32 (H, W, 4)."""
-        job = replace(self.job(request), format="npy")
-        linear = self.renderer.render(job, self.mesh_presets.get(job.preset)).linear
+        prepared = self.prepare(request)
+        job = replace(prepared.job, format="npy")
+        linear = self.renderer.render(job, prepared.preset).linear
         assert linear is not None  # an npy job always reads back linear radiance
         return linear
 

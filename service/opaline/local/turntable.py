@@ -45,9 +45,8 @@ def render_turntable(request: TurntableRequest | Mapping[str, Any], *,
 
 def turntable_bytes(local: LocalRenderer, request: TurntableRequest,
                     progress: Progress | None = None) -> bytes:
-    still = request.still()
-    preset = local.preset(still)
-    job = local.job(still)
+    prepared = local.prepare(request.still())
+    preset, job = prepared.preset, prepared.job
     check_turntable_cost(job, request.frames, local.budget)
     frames: list[np.ndarray] = []
     jobs = frame_jobs(job, preset, request.frames)

@@ -15,11 +15,11 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
 from opaline.model.params import Material
+from opaline.model.tiers import TIERS, Measured, Tier, auto_tier
 
 TABLE_PATH = Path(__file__).resolve().parent / "quality_table.json"
 TABLE_SIZE = 128  # the table's renders are TABLE_SIZE² pixels
@@ -90,24 +90,6 @@ def at_most(easy: dict, hard: dict) -> bool:
         easy[k] <= hard[k] * (1.0 + 1e-6) + tol for k in MEASURES)
 
 
-@dataclass(frozen=True)
-class Pick:
-    """What auto chose and why: the setting, its measured errors, and the basis."""
-
-    samples: int
-    wavelengths: int
-    aa: str
-    flip: float | None
-    delta_e_p95: float | None
-    basis: str
-    max_flip: float | None = None
-    max_delta_e: float | None = None
-
-    @property
-    def setting(self) -> dict[str, object]:
-        return {"samples": self.samples, "wavelengths": self.wavelengths, "aa": self.aa}
-
-
 @cache
 def load_table(path: Path = TABLE_PATH) -> dict:
     return json.loads(path.read_text())
@@ -120,19 +102,19 @@ def preset_digest(preset) -> str:
 
 
 def pick(preset_name: str, material: Material, width: int, height: int, exposure: float,
-         max_flip: float | None, max_delta_e: float | None, table: dict | None = None) -> Pick:
+         max_flip: float | None, max_delta_e: float | None, table: dict | None = None) -> Tier:
     """The fastest measured setting meeting the targets on the measured materials that stand
-    for ``material`` (judged_on; the point-wise worst among them), or the fallback tier."""
-    from opaline.model.tiers import TIERS
-
+    for ``material`` (judged_on; the point-wise worst among them), or the fallback tier's
+    setting; as a tier of its own that says why."""
     table = table or load_table()
-    fallback = TIERS[FALLBACK]
     entry = table["presets"].get(preset_name)
     wanted = difficulty(material, width, height, exposure)
 
-    def fall_back(why: str) -> Pick:
-        return Pick(int(fallback["samples"]), int(fallback["wavelengths"]), str(fallback["aa"]),
-                    None, None, f"fallback ({why}): {FALLBACK} tier", max_flip, max_delta_e)
+    def fall_back(why: str) -> Tier:
+        fallback = TIERS[FALLBACK]
+        return auto_tier(fallback.samples, fallback.wavelengths, fallback.aa,
+                         Measured(None, None, f"fallback ({why}): {FALLBACK} tier", max_flip,
+                                  max_delta_e))
 
     if entry is None:
         return fall_back("preset not measured")
@@ -164,8 +146,9 @@ def pick(preset_name: str, material: Material, width: int, height: int, exposure
         return fall_back("no measured setting meets the target")
     point, flip, delta_e = best
     names = "+".join(m["variant"] for m in judged)
-    return Pick(point["samples"], point["wavelengths"], point["aa"], flip, delta_e,
-                f"measured on {preset_name} ({names})", max_flip, max_delta_e)
+    return auto_tier(point["samples"], point["wavelengths"], point["aa"],
+                     Measured(flip, delta_e, f"measured on {preset_name} ({names})", max_flip,
+                              max_delta_e))
 
 
 def judged_on(measured: list[dict], material: Material, wanted: dict) -> tuple[list[dict], bool]:
@@ -204,9 +187,9 @@ def auto_headers(job) -> dict[str, str]:
     """Response headers saying what quality=auto picked; empty for other qualities.
 
     For the HTTP layer: ``response.headers.update(auto_headers(job))``."""
-    if job.quality != "auto" or job.auto is None:
+    chosen = job.tier.measured
+    if chosen is None:
         return {}
-    chosen = job.auto
     targets = [f"{name}={value:g}" for name, value in
                (("max_flip", chosen.max_flip), ("max_delta_e", chosen.max_delta_e))
                if value is not None]

@@ -1,18 +1,18 @@
 """Request parameters: the one place their names, ranges, defaults and docs live.
 
 The ranges are the table of docs/design.md §5; the messages that explain a
-rejected value are in ``opaline.model.messages``. The CLI's ``--help``, the HTTP API's OpenAPI schema, preset
-files and material files all read these models, so a range is written once.
+rejected value are in ``opaline.model.messages``; the material's own fields are
+declared in ``opaline.model.material``. The CLI's ``--help``, the HTTP API's
+OpenAPI schema, preset files and material files all read these models, so a
+range is written once.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
-    ConfigDict,
     Field,
     ValidationError,
     ValidationInfo,
@@ -22,31 +22,28 @@ from pydantic_core import PydanticCustomError
 
 from opaline.model import messages
 
+# Re-exported: the material's fields are declared in opaline.model.material.
+from opaline.model.material import MATERIAL_FIELDS as MATERIAL_FIELDS
+from opaline.model.material import STRICT as STRICT
+from opaline.model.material import TWO_PI as TWO_PI
+from opaline.model.material import Material as Material
+from opaline.model.material import MaterialFields as MaterialFields
+from opaline.model.material import MdfName as MdfName
+
 # Re-exported: the CLI and the API read a field's range next to the models.
 from opaline.model.messages import field_range as field_range
-from opaline.model.physical_params import PhysicalFields, PhysicalMaterial
 from opaline.model.scene_fields import SceneFields
+from opaline.model.tiers import AntiAliasName, QualityName
 
-TWO_PI = 2.0 * math.pi
-
-MdfName = Literal["ashikhmin", "multipeak"]
 ImageFormat = Literal["png", "png16", "npy", "webp", "webp-lossless", "avif", "jpeg"]
 # 'auto': the HTTP service picks from the Accept header (anything else draws PNG).
 RequestFormat = Literal[ImageFormat, "auto"]
 Tonemap = Literal["none", "reinhard", "aces"]
-Quality = Literal["draft", "standard", "high", "reference", "auto"]
-AntiAlias = Literal["none", "analytic"]
+# The tiers' own (model/tiers.py): a request names one, or auto.
+Quality = QualityName
+AntiAlias = AntiAliasName
 
-Exponent = Annotated[float, Field(ge=0.0, le=1e6)]
-Frequency = Annotated[float, Field(ge=0.0, le=1000.0)]
-Anisotropy = Annotated[float, Field(ge=0.0, le=1000.0)]
-Angle = Annotated[float, Field(ge=-TWO_PI, le=TWO_PI)]
-Weight = Annotated[float, Field(ge=0.0, le=100.0)]
-Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 Pixels = Annotated[int, Field(ge=16, le=2048)]
-
-STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
-
 
 MIN_WAVELENGTHS = 4  # 1-3 score worse than the RGB model at every sample count (docs/accuracy.md)
 
@@ -77,46 +74,7 @@ def wavelengths_schema(schema: dict[str, Any]) -> None:
         schema["not"] = {"enum": refused}
 
 
-class MaterialFields(PhysicalFields):
-    """Material parameters; ``None`` means "take the preset's value"."""
-
-    model_config = STRICT
-
-    mdf: MdfName | None = Field(
-        None, description="Microfacet distribution: 'ashikhmin' (eq. 1) or 'multipeak' (eqs. 3-4)."
-    )
-    ex: Exponent | None = Field(
-        None, description="Ashikhmin-Shirley exponent along the tangent (eq. 1), 0 … 1e6."
-    )
-    ey: Exponent | None = Field(
-        None, description="Ashikhmin-Shirley exponent along the bitangent (eq. 1), 0 … 1e6."
-    )
-    mu_f: Frequency | None = Field(
-        None, description="Multi-peak frequency: rings across the MDF disc (eq. 4), 0 … 1000."
-    )
-    alpha: Anisotropy | None = Field(
-        None, description="Multi-peak anisotropy along the tangent (eq. 4), 0 … 1000."
-    )
-    beta: Anisotropy | None = Field(
-        None, description="Multi-peak anisotropy along the bitangent (eq. 4), 0 … 1000."
-    )
-    theta1: Angle | None = Field(
-        None, description="Rotation of the green channel's MDF in radians (eq. 2), -2π … 2π."
-    )
-    theta2: Angle | None = Field(
-        None, description="Rotation of the blue channel's MDF in radians (eq. 2), -2π … 2π."
-    )
-    kd: Weight | None = Field(None, description="Diffuse weight, 0 … 100.")
-    ks: Weight | None = Field(None, description="Specular weight, 0 … 100.")
-    albedo: tuple[Unit, Unit, Unit] | None = Field(
-        None, description="Diffuse colour, linear RGB, each 0 … 1."
-    )
-    f0: Unit | None = Field(
-        None, description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off)."
-    )
-
-
-class RenderFields(MaterialFields, SceneFields):
+class RenderFields(MaterialFields, SceneFields):  # type: ignore[misc,valid-type]  # generated
     """What a request (or a preset's defaults) may set besides the material."""
 
     width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")
@@ -192,28 +150,6 @@ class RenderRequest(RenderFields):
     """A render request: a preset and any fields that override its defaults."""
 
     preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
-
-
-class Material(PhysicalMaterial):
-    """A fully specified material, as the renderer consumes it."""
-
-    model_config = STRICT
-
-    mdf: MdfName = "multipeak"
-    ex: Exponent = 100.0
-    ey: Exponent = 10.0
-    mu_f: Frequency = 8.5
-    alpha: Anisotropy = 2.0
-    beta: Anisotropy = 1.2
-    theta1: Angle = 0.1
-    theta2: Angle = 0.2
-    kd: Weight = 0.0
-    ks: Weight = 1.0
-    albedo: tuple[Unit, Unit, Unit] = (0.5, 0.5, 0.5)
-    f0: Unit = 1.0
-
-
-MATERIAL_FIELDS = tuple(Material.model_fields)
 
 
 def describe_errors(

@@ -17,7 +17,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from opaline.model.params import STRICT, RenderFields, Unit, describe_errors
+from opaline.model.material import Unit
+from opaline.model.params import STRICT, RenderFields, describe_errors
 from opaline.resources import presets_dir
 from opaline.scene import geometry, meshfile, normalmaps, thickness
 

@@ -10,13 +10,14 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import asdict, dataclass
+from typing import Any
 
 from opaline import __version__
-from opaline.model.auto import DEFAULT_MAX_FLIP, Pick, pick
+from opaline.model.auto import DEFAULT_MAX_FLIP, pick
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.scene_fields import MESH_FIELDS
-from opaline.model.tiers import TIERS
+from opaline.model.tiers import TIERS, Tier
 from opaline.resources import sources_digest
 
 BASE_DEFAULTS = {
@@ -44,7 +45,7 @@ class Job:
     height: int
     format: str
     transparent: bool
-    quality: str
+    tier: Tier  # the quality tier, or quality=auto's pick; the three below may override it
     samples: int
     wavelengths: int
     aa: str
@@ -60,22 +61,30 @@ class Job:
     environment_intensity: float | None = None
     environment_lights: int | None = None
     environment_background: bool | None = None
-    # quality="auto": what model/auto.py picked and why (None for the tiers).
-    auto: Pick | None = None
+
+    @property
+    def quality(self) -> str:
+        return self.tier.name
+
+    @property
+    def environment_count(self) -> int:
+        """K: the lights an environment becomes, the job's own count or its tier's."""
+        return self.environment_lights or self.tier.environment_lights
 
     @property
     def cost(self) -> int:
         return self.width * self.height * self.samples * max(self.wavelengths, 3)
 
-    def canonical(self) -> dict:
+    def canonical(self) -> dict[str, Any]:
         # Field by field: asdict() deep-copied the material only for it to be dumped again
         # (a twentieth of the service's own time on a cache miss).
-        data = {name: getattr(self, name) for name in self.__dataclass_fields__}
+        # The tier by its name, where the field has always stood (answers keep their order).
+        data = {("quality" if name == "tier" else name): getattr(self, name)
+                for name in self.__dataclass_fields__}
         data["material"] = self.material.model_dump(mode="json")
-        if self.auto is None:
-            del data["auto"]  # tier jobs keep the keys they had before quality=auto
-        else:
-            data["auto"] = asdict(self.auto)
+        data["quality"] = self.tier.name
+        if self.tier.measured is not None:  # tier jobs keep the keys they had before auto
+            data["auto"] = {**self.tier.render_settings(), **asdict(self.tier.measured)}
         return data
 
     def cache_key(self, scene_key: str) -> str:
@@ -92,39 +101,60 @@ def content_key(payload: dict) -> str:
     return hashlib.sha256(json.dumps(stamped, sort_keys=True).encode()).hexdigest()[:32]
 
 
+def preset_fields(preset: Preset) -> dict[str, Any]:
+    """What a request on ``preset`` starts from: the built-in defaults, then the preset's."""
+    fields: dict[str, Any] = dict(BASE_DEFAULTS)
+    fields.update(preset.defaults.model_dump(exclude_none=True, exclude=set(MESH_FIELDS)))
+    return fields
+
+
+def preset_material(preset: Preset) -> Material:
+    """The material a request on ``preset`` that sets no material field draws."""
+    fields = preset_fields(preset)
+    return Material(**{k: fields[k] for k in MATERIAL_FIELDS if k in fields})
+
+
 def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None) -> Job:
-    """Merge built-in defaults, the preset's defaults and the request's fields."""
+    """Merge built-in defaults, the preset's defaults, the request's fields and the tier."""
     if preset is None:
         preset = get_preset(getattr(request, "preset", "sphere"))
-    fields: dict = dict(BASE_DEFAULTS)
-    fields.update(preset.defaults.model_dump(exclude_none=True, exclude=set(MESH_FIELDS)))
-    fields.update(request.model_dump(exclude_none=True, exclude={"preset", *MESH_FIELDS}))
+    fields = dict(preset_fields(preset))
+    fields.update(unsigned_zeros(request.model_dump(exclude_none=True,
+                                                    exclude={"preset", *MESH_FIELDS})))
     targets = {k: fields.pop(k, None) for k in ("max_flip", "max_delta_e")}
     if "quality" not in request.model_fields_set and any(v is not None for v in targets.values()):
         fields["quality"] = "auto"  # an error budget asks for auto unless a tier is named
     material = Material(**{k: fields.pop(k) for k in MATERIAL_FIELDS if k in fields})
-    chosen = None
-    if fields["quality"] == "auto":
-        chosen = pick_for(preset.name, material, fields, **targets)
-        tier = chosen.setting
-    else:
-        tier = TIERS[fields["quality"]]
-    for name, value in tier.items():
+    quality = fields.pop("quality")
+    tier = pick_for(preset.name, material, fields, **targets) if quality == "auto" else TIERS[quality]
+    for name, value in tier.render_settings().items():
         fields.setdefault(name, value)
     if fields["format"] == "auto":  # the HTTP service negotiates before resolving
         fields["format"] = "png"
     return Job(
         preset=preset.name,
         material=material,
+        tier=tier,
         light_azimuth=fields.pop("light_azimuth", None),
         light_elevation=fields.pop("light_elevation", None),
-        auto=chosen,
         **fields,
     )
 
 
-def pick_for(preset: str, material: Material, fields: dict, max_flip: float | None,
-             max_delta_e: float | None) -> Pick:
+def unsigned_zeros(fields: dict[str, Any]) -> dict[str, Any]:
+    """-0.0 as 0.0: the renderer cannot tell them apart, so one image has one key (and one
+    canonical URL, whose spelling has no sign on zero)."""
+    def clean(value: Any) -> Any:
+        if isinstance(value, float):
+            return value + 0.0
+        if isinstance(value, tuple | list):
+            return type(value)(clean(v) for v in value)
+        return value
+    return {name: clean(value) for name, value in fields.items()}
+
+
+def pick_for(preset: str, material: Material, fields: dict[str, Any], max_flip: float | None,
+             max_delta_e: float | None) -> Tier:
     """quality=auto's choice for this preset, material and size (model/auto.py); with no
     budget given, FLIP 0.05."""
     if max_flip is None and max_delta_e is None:

@@ -1,20 +1,80 @@
-"""The named quality tiers: each a bundle of samples, wavelengths and anti-aliasing,
-chosen from the measured speed/accuracy fronts (docs/accuracy.md)."""
+"""The quality tiers: what each one renders with, as one typed value.
+
+A ``Tier`` owns every knob a quality level sets: samples, wavelengths,
+anti-aliasing and the number of lights an environment becomes. The named
+tiers are points on the measured speed/accuracy fronts (docs/accuracy.md);
+``quality=auto`` makes one of its own (``model/auto.py``), with the
+measurement that chose it. A request may still override samples,
+wavelengths, AA and environment lights one by one; the ``Job`` keeps its tier
+and the values it ends up with.
+"""
 
 from __future__ import annotations
 
-# What each quality tier means; a request may override any field of it.
-TIERS: dict[str, dict[str, object]] = {
+from dataclasses import dataclass
+from typing import Literal, get_args
+
+TierName = Literal["draft", "standard", "high", "reference"]
+QualityName = Literal["draft", "standard", "high", "reference", "auto"]
+AntiAliasName = Literal["none", "analytic"]
+
+
+@dataclass(frozen=True)
+class Measured:
+    """Why quality=auto chose its setting: the errors measured there, against what budget."""
+
+    flip: float | None
+    delta_e_p95: float | None
+    basis: str
+    max_flip: float | None = None
+    max_delta_e: float | None = None
+
+
+@dataclass(frozen=True)
+class Tier:
+    name: QualityName
+    samples: int
+    wavelengths: int
+    aa: AntiAliasName
+    # K directional lights an environment becomes (bench/results/environment_lights.md,
+    # 256², against K=256): each light costs about as much as the rest of the shading, and
+    # ΔE00 mean falls from 2-4 (K=8) through 1-2.3 (16) and 0.6-1.6 (32) to 0.35-1 (64).
+    environment_lights: int
+    measured: Measured | None = None  # quality=auto only
+
+    def render_settings(self) -> dict[str, int | str]:
+        """The fields a request may override one by one, as the tier sets them."""
+        return {"samples": self.samples, "wavelengths": self.wavelengths, "aa": self.aa}
+
+    def describe(self) -> dict[str, int | str]:
+        """The tier as GET /v1/tiers and ``--help`` show it."""
+        return {"name": self.name, **self.render_settings(),
+                "environment_lights": self.environment_lights}
+
+
+TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # Points on the measured fronts (docs/accuracy.md), one bundle for every preset. On most
     # presets the RGB model's own error outweighs one sample's aliasing, so the cheap tiers
     # buy wavelengths before samples: one sample of 8 wavelengths, band-limited, costs
     # little more than one RGB sample and has a third to half of its error.
-    "draft": {"samples": 1, "wavelengths": 8, "aa": "analytic"},
+    Tier("draft", samples=1, wavelengths=8, aa="analytic", environment_lights=8),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
-    "standard": {"samples": 1, "wavelengths": 16, "aa": "analytic"},
+    Tier("standard", samples=1, wavelengths=16, aa="analytic", environment_lights=16),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
-    "high": {"samples": 8, "wavelengths": 16, "aa": "none"},
+    Tier("high", samples=8, wavelengths=16, aa="none", environment_lights=32),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
-    "reference": {"samples": 64, "wavelengths": 32, "aa": "none"},
-}
+    Tier("reference", samples=64, wavelengths=32, aa="none", environment_lights=64),
+)}
+if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
+    raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
+
+
+def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measured) -> Tier:
+    """quality=auto's tier: the setting it picked, with as many environment lights as the
+    cheapest named tier that has at least its samples and wavelengths (the table measured
+    the material, not the light, so the lights follow the accuracy of the setting)."""
+    like = next((tier for tier in TIERS.values()
+                 if tier.samples >= samples and tier.wavelengths >= wavelengths),
+                TIERS["reference"])
+    return Tier("auto", samples, wavelengths, aa, like.environment_lights, measured)

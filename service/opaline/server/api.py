@@ -25,7 +25,9 @@ from opaline.gl.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
+from opaline.model.tiers import TIERS
 from opaline.model.turntable import TurntableRequest
+from opaline.pipeline.prepare import prepare
 from opaline.server.access import Access
 from opaline.server.cache import ImageCache
 from opaline.server.connections import STATS as CONNECTION_STATS
@@ -37,13 +39,13 @@ from opaline.server.meshstore import MeshStore
 from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
-from opaline.server.schemas import Health, PresetInfo, Readiness
+from opaline.server.schemas import Health, PresetInfo, Readiness, TierInfo
 from opaline.server.service import Service, SettingsDep, get_service
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.factory import RendererFactory
 from opaline.workers.pool import WorkerPool
-from opaline.workers.tasks import ImageTask
+from opaline.workers.tasks import PRIVATE, ImageTask
 
 WEB_DIR = Path(__file__).resolve().parent / "web"
 ServiceDep = Annotated[Service, Depends(get_service)]
@@ -70,6 +72,12 @@ def _rounded(direction: dict[str, float] | None) -> dict[str, float] | None:
 @router.get("/v1/presets", tags=["presets"], summary="Every preset with its defaults")
 async def presets_list() -> list[PresetInfo]:
     return [preset_info(p) for p in all_presets().values()]
+
+
+@router.get("/v1/tiers", tags=["presets"],
+            summary="The quality tiers: samples, wavelengths, AA and environment lights of each")
+async def tiers_list() -> list[TierInfo]:
+    return [TierInfo.model_validate(tier.describe()) for tier in TIERS.values()]
 
 
 @router.get("/v1/presets/{name}", tags=["presets"], summary="One preset with its defaults",
@@ -112,8 +120,7 @@ async def metrics_get(svc: ServiceDep) -> Response:
 
 def warmup_task() -> ImageTask:
     """Compile the default preset's shaders before the first request."""
-    job = resolve(RenderRequest(width=16, height=16, quality="draft"))
-    return ImageTask(job, get_preset(job.preset))
+    return ImageTask(prepare(RenderRequest(width=16, height=16, quality="draft"), PRIVATE))
 
 
 def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:

@@ -26,6 +26,8 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.presets import UnknownPreset
 from opaline.model.request import CostError
+from opaline.pipeline.limits import LimitError
+from opaline.pipeline.prepare import UnknownEnvironment
 from opaline.server.meshstore import InvalidMesh, MeshTooLarge, UnknownMesh
 from opaline.server.metrics import REJECT_REASONS, Metrics
 from opaline.server.queries import Malformed, MdfQuery
@@ -38,18 +40,6 @@ from opaline.workers.errors import (
     TooSlow,
     Unavailable,
 )
-
-
-class LimitError(ValueError):
-    """A request within the parameter ranges but over this service's configured limits."""
-
-    def __init__(self, problems: list[str]) -> None:
-        super().__init__("; ".join(problems))
-        self.problems = problems
-
-
-class UnknownEnvironment(LookupError):
-    """An environment name that is neither built in nor a file of the environments folder."""
 
 
 class UnknownTurntable(LookupError):

@@ -9,11 +9,11 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import Response
 
 from opaline.model.params import RenderRequest
-from opaline.model.presets import Preset
-from opaline.model.request import Job, content_key, resolve
+from opaline.model.request import content_key
+from opaline.pipeline.prepare import prepare
 from opaline.server.errors import ERROR_RESPONSES
 from opaline.server.queries import RenderQuery, parse_body
-from opaline.server.render_routes import BODY, RENDER_RESPONSES, scene_preset
+from opaline.server.render_routes import BODY, RENDER_RESPONSES
 from opaline.server.service import Service, get_service
 from opaline.workers.export_task import GlbTask, GlslTask
 
@@ -21,17 +21,12 @@ ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 
-def _resolved(request: Request, svc: Service, params: RenderRequest) -> tuple[Preset, Job]:
-    preset = scene_preset(request, svc, params)
-    return preset, resolve(params, preset)
-
-
 @router.get("/v1/export/glsl", tags=["export"], response_class=Response,
             responses={**ERROR_RESPONSES, 404: RENDER_RESPONSES[404]},
             summary="The material as one self-contained GLSL function (opaline_radiance)")
 async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Request,
                           svc: ServiceDep) -> Response:
-    _, job = _resolved(request, svc, params)
+    job = prepare(params, svc.context).job
     key = content_key({"glsl": job.canonical()})
     data = await svc.pool.render(key, GlslTask(job.material, job.wavelengths),
                                  timeout=svc.wait_s)
@@ -45,7 +40,8 @@ async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Requ
              summary="The mesh with the material as glTF 2.0 binary (.glb)")
 async def export_glb_post(request: Request, svc: ServiceDep) -> Response:
     body = parse_body(await request.body(), RenderRequest)
-    preset, job = _resolved(request, svc, body)
+    prepared = prepare(body, svc.context)
+    preset, job = prepared.preset, prepared.job
     key = content_key({"glb": job.canonical(), "scene": preset.scene_key()})
     data = await svc.pool.render(key, GlbTask(preset, job.material, job.wavelengths),
                                  timeout=svc.wait_s)

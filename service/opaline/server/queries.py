@@ -14,11 +14,11 @@ from typing import Any, Literal, TypeVar, Union, get_args, get_origin
 from pydantic import BaseModel, Field, field_validator
 from pydantic_core import from_json, to_json
 
+from opaline.model.material import Unit
 from opaline.model.params import (
     MaterialFields,
     Pixels,
     RenderRequest,
-    Unit,
     wavelengths_ok,
     wavelengths_schema,
 )

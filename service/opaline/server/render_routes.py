@@ -17,23 +17,20 @@ from fastapi.responses import Response
 
 from opaline.model.auto import auto_headers
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
-from opaline.model.presets import Preset, get_preset
-from opaline.model.request import Job, check_cost, check_plot_cost, resolve
+from opaline.model.request import check_plot_cost
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
-from opaline.output.formats import HAS_ALPHA
-from opaline.scene.environments import EnvironmentMapError, check_name
+from opaline.pipeline.limits import LimitError, over_limit
+from opaline.pipeline.prepare import prepare
 from opaline.server.cache import etag, matches, mdf_key
 from opaline.server.canonical import (
     IMMUTABLE,
     CanonicalMdfQuery,
     CanonicalQuery,
-    canonical_job,
     canonical_plot,
-    canonical_url,
     is_canonical,
     mdf_url,
 )
-from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, UnknownEnvironment
+from opaline.server.errors import ERROR_RESPONSES, Problem
 from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.query_params import documented, query_model
@@ -47,24 +44,10 @@ ServiceDep = Annotated[Service, Depends(get_service)]
 
 
 
-def _over_limit(name: str, value: int, limit: int) -> str:
-    return f"{name}={value} is out of range: allowed [16 … {limit}] on this service"
-
-
-def check_limits(job: Job, settings: Settings) -> None:
-    problems = [_over_limit(name, value, limit)
-                for name, value, limit in (("width", job.width, settings.max_width),
-                                           ("height", job.height, settings.max_height))
-                if value > limit]
-    if problems:
-        raise LimitError(problems)
-    check_cost(job, settings.cost_budget)
-
-
 def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     size = min(settings.max_width, settings.max_height)
     if params.size > size:
-        raise LimitError([_over_limit("size", params.size, size)])
+        raise LimitError([over_limit("size", params.size, size)])
     check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
 
 
@@ -105,22 +88,6 @@ async def answer_image(svc: Service, request: Request, key: str, task: Task, fmt
     return image_response(data, MEDIA_TYPES[fmt], headers)
 
 
-def scene_preset(request: Request, svc: Service, params: RenderRequest) -> Preset:
-    """The preset a request draws (its mesh's, if it names one), after checking that its
-    environment exists: names are the built-ins plus the files of a folder, which the schema
-    cannot list, so an unknown one is 404 ``unknown_environment`` (as presets are)."""
-    preset = get_preset(params.preset)
-    if params.mesh is not None:
-        preset = request.app.state.meshes.preset(params, preset,
-                                                 svc.settings.mesh_max_triangles)
-    if params.environment is not None:
-        try:
-            check_name(params.environment, svc.settings.environments_dir)
-        except EnvironmentMapError as exc:
-            raise UnknownEnvironment(str(exc)) from None
-    return preset
-
-
 async def answer_render(svc: Service, request: Request, params: RenderRequest,
                         started: float) -> Response:
     """Every answer names the image's canonical GET URL in Content-Location; only that URL
@@ -129,19 +96,13 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest,
     auto = params.format == "auto"
     if auto:
         params = negotiated(params, request)
-    preset = scene_preset(request, svc, params)
-    job, query = canonical_job(resolve(params, preset), preset, params)
-    if job.transparent and job.format not in HAS_ALPHA:
-        raise LimitError([f"format={job.format} has no alpha channel: transparent=true needs "
-                          "png, png16, webp, webp-lossless or avif"])
-    check_limits(job, svc.settings)
-    key = job.cache_key(preset.scene_key())
-    url = canonical_url(query, key)
+    prepared = prepare(params, svc.context)
+    job, url = prepared.job, prepared.url()
     headers = {"Content-Location": url, **auto_headers(job)}  # what quality=auto picked
     if request.method == "GET" and is_canonical(request.url.query, url):
         headers["Cache-Control"] = IMMUTABLE
-    return await answer_image(svc, request, key, ImageTask(job, preset), job.format, preset.name,
-                              started, headers, vary=auto)
+    return await answer_image(svc, request, prepared.key, ImageTask(prepared), job.format,
+                              prepared.preset.name, started, headers, vary=auto)
 
 
 IMAGE = {"schema": {"type": "string", "format": "binary"}}

@@ -42,3 +42,13 @@ class Readiness(BaseModel):
     workers: list[dict[str, Any]] = Field(
         description="Each worker process: name, state (starting, ready, busy, failed, stopped), "
         "pid, renders, rss_bytes, restarts, its GL context's description, and the last error.")
+
+
+class TierInfo(BaseModel):
+    """A quality tier: what ``quality=<name>`` renders with unless the request overrides it."""
+
+    name: str
+    samples: int = Field(description="Samples per pixel.")
+    wavelengths: int = Field(description="Wavelengths integrated (0: the paper's RGB model).")
+    aa: str = Field(description="Anti-aliasing: 'analytic' or 'none'.")
+    environment_lights: int = Field(description="Directional lights an environment becomes.")

@@ -8,7 +8,12 @@ from typing import Annotated
 
 from fastapi import Depends, Request
 
+from opaline.model.params import RenderRequest
+from opaline.model.presets import Preset
+from opaline.pipeline.limits import Limits
+from opaline.pipeline.prepare import Context
 from opaline.server.cache import ImageCache
+from opaline.server.meshstore import MeshStore
 from opaline.server.metrics import Metrics
 from opaline.settings import Settings, get_settings
 from opaline.workers.pool import WorkerPool
@@ -20,6 +25,18 @@ class Service:
     pool: WorkerPool
     cache: ImageCache
     metrics: Metrics
+    meshes: MeshStore
+
+    @property
+    def context(self) -> Context:
+        """Requests are prepared against this service's limits, its uploaded meshes and its
+        environments folder."""
+        s = self.settings
+        return Context(Limits(s.cost_budget, s.max_width, s.max_height), self.mesh_preset,
+                       s.environments_dir)
+
+    def mesh_preset(self, request: RenderRequest, preset: Preset) -> Preset:
+        return self.meshes.preset(request, preset, self.settings.mesh_max_triangles)
 
     @property
     def wait_s(self) -> float:
@@ -51,4 +68,5 @@ async def get_service(request: Request) -> Service:
     runs a plain ``def`` one in its thread pool, a hand-off there and back (0.2-0.3 ms of a
     cache miss on two busy cores)."""
     state = request.app.state
-    return Service(await app_settings(request), state.pool, state.cache, state.metrics)
+    return Service(await app_settings(request), state.pool, state.cache, state.metrics,
+                   state.meshes)

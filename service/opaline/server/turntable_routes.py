@@ -27,9 +27,10 @@ from fastapi import APIRouter, Depends, Request
 from fastapi.responses import Response
 from pydantic import BaseModel
 
-from opaline.model.request import content_key, resolve
+from opaline.model.request import content_key
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
 from opaline.output.animation import EXTENSIONS, MEDIA_TYPES
+from opaline.pipeline.prepare import prepare
 from opaline.server.errors import (
     ERROR_RESPONSES,
     RETRY_AFTER,
@@ -39,7 +40,7 @@ from opaline.server.errors import (
     UnknownTurntable,
 )
 from opaline.server.queries import parse_body
-from opaline.server.render_routes import RENDER_RESPONSES, check_limits, scene_preset
+from opaline.server.render_routes import RENDER_RESPONSES
 from opaline.server.service import Service, get_service
 from opaline.workers.animation_task import AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
@@ -157,13 +158,10 @@ BODY = {"requestBody": {"required": True, "content": {
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
 async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
     body = parse_body(await request.body(), TurntableRequest)
-    still = body.still()
-    preset = scene_preset(request, svc, still)
-    job = resolve(still, preset)
-    check_limits(job, svc.settings)
-    check_turntable_cost(job, body.frames, svc.settings.cost_budget)
-    jobs = frame_jobs(job, preset, body.frames)
-    tasks = [(j.cache_key(preset.scene_key()), ImageTask(j, preset)) for j in jobs]
+    still = prepare(body.still(), svc.context)
+    check_turntable_cost(still.job, body.frames, svc.settings.cost_budget)
+    frames = [still.with_job(job) for job in frame_jobs(still.job, still.preset, body.frames)]
+    tasks = [(frame.key, ImageTask(frame)) for frame in frames]
     predicted = svc.pool.cost.predict(*tasks[0][1].units())
     if predicted > svc.settings.deadline_s:  # every frame would be refused: say so now
         raise TooSlow(f"each frame is predicted to take {predicted:.1f} s, over the "

@@ -12,14 +12,24 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from opaline.gl.lighting import environment_count
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, all_presets
-from opaline.model.request import Job, resolve
-from opaline.output.encode import encode_frame, encode_mdf
+from opaline.model.request import Job
+from opaline.output.encode import encode_mdf
+from opaline.pipeline.limits import Limits
+from opaline.pipeline.prepare import Context, Prepared, prepare
+from opaline.pipeline.produce import produce
 
 StopCheck = Callable[[], bool]
 MDF_LABEL = "mdf-plot"
+
+
+def no_meshes(request: RenderRequest, preset: Preset) -> Preset:
+    raise AssertionError("the worker's own renders draw presets only")
+
+
+# The worker's own renders (calibration, warm-up): built-in presets, no budget.
+PRIVATE = Context(Limits(cost_budget=None), no_meshes)
 
 
 class Task(Protocol):
@@ -32,25 +42,27 @@ class Task(Protocol):
 
 @dataclass(frozen=True)
 class ImageTask:
-    """Render a resolved job and encode it in the job's format."""
+    """Render a prepared job and encode it in the job's format (``pipeline.produce``)."""
 
-    job: Job
-    preset: Preset
+    prepared: Prepared
+
+    @property
+    def job(self) -> Job:
+        return self.prepared.job
 
     @property
     def label(self) -> str:
-        return self.preset.name
+        return self.prepared.preset.name
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
-        frame = renderer.render(self.job, self.preset, should_stop=should_stop)
-        return encode_frame(frame, self.job.format, alpha=self.job.transparent)
+        return produce(self.prepared, renderer, should_stop)
 
     def units(self) -> tuple[str, float, int]:
-        job = self.job
+        job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
         if job.environment:  # calibrated on the preset's lights; the cost grows with K
-            units *= max(1.0, environment_count(job) / len(self.preset.lights))
-        return self.preset.name, units, job.wavelengths
+            units *= max(1.0, job.environment_count / len(preset.lights))
+        return preset.name, units, job.wavelengths
 
 
 @dataclass(frozen=True)
@@ -89,23 +101,22 @@ class CalibrateTask:
         for name, preset in all_presets().items():
             timings[name] = [self._time(renderer, preset, w, should_stop)
                              for w in (0, CALIBRATION_WAVELENGTHS)]
-        tiny = resolve(RenderRequest(width=16, height=16, samples=1, wavelengths=0,
-                                     quality="draft"))
-        overhead = self._time_job(renderer, tiny, all_presets()[tiny.preset], should_stop)
+        tiny = RenderRequest(width=16, height=16, samples=1, wavelengths=0, quality="draft")
+        overhead = self._time_job(renderer, tiny, should_stop)
         units = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
         return json.dumps({"overhead_s": overhead, "units": units,
                            "wavelengths": CALIBRATION_WAVELENGTHS, "timings": timings}).encode()
 
     def _time(self, renderer: Any, preset: Preset, wavelengths: int, should_stop: StopCheck
               ) -> float:
-        job = resolve(RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
-                                    height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
-                                    wavelengths=wavelengths), preset)
-        return self._time_job(renderer, job, preset, should_stop)
+        request = RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
+                                height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
+                                wavelengths=wavelengths)
+        return self._time_job(renderer, request, should_stop)
 
     @staticmethod
-    def _time_job(renderer: Any, job: Job, preset: Preset, should_stop: StopCheck) -> float:
-        task = ImageTask(job, preset)
+    def _time_job(renderer: Any, request: RenderRequest, should_stop: StopCheck) -> float:
+        task = ImageTask(prepare(request, PRIVATE))
         task.run(renderer, should_stop)  # compiles the variant
         start = time.perf_counter()
         task.run(renderer, should_stop)

@@ -1,0 +1,154 @@
+"""Every material field, declared once: its type and range, default, unit, description,
+and which colour source or MDF reads it.
+
+``Material`` is the resolved material the renderer consumes. ``MaterialFields``,
+the same fields all optional (``None``: take the preset's value), is generated
+from it, so requests, presets, material files, the CLI's ``--help`` and the
+OpenAPI schema all read one declaration. A field's ``x-applies`` (in the
+schema) says under which ``iridescence`` / ``mdf`` it is read at all, and its
+``x-group`` where the tuning page puts it.
+
+``iridescence`` chooses where colour comes from: ``rotation`` is the paper's
+per-channel rotated MDF (Kang et al. 2014, eq. 2); ``thin-film`` and
+``grating`` keep the Ashikhmin-Shirley lobe (eq. 1, unrotated) as the
+distribution of facet normals and take their colour from optics
+(docs/physics.md). Names and units of the film follow glTF's
+KHR_materials_iridescence (IOR, thickness in nm); the grating's pitch is in µm.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, create_model
+
+TWO_PI = 2.0 * math.pi
+STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+IridescenceName = Literal["rotation", "thin-film", "grating"]
+MdfName = Literal["ashikhmin", "multipeak"]
+
+Exponent = Annotated[float, Field(ge=0.0, le=1e6)]
+Frequency = Annotated[float, Field(ge=0.0, le=1000.0)]
+Anisotropy = Annotated[float, Field(ge=0.0, le=1000.0)]
+Angle = Annotated[float, Field(ge=-TWO_PI, le=TWO_PI)]
+Weight = Annotated[float, Field(ge=0.0, le=100.0)]
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+# Film and substrate indices: real (lossless) dielectrics from air up to about
+# diamond-and-beyond; absorbing substrates (metals) are out of scope.
+FilmIor = Annotated[float, Field(ge=1.0, le=3.0)]
+SubstrateIor = Annotated[float, Field(ge=1.0, le=4.0)]
+# Thickness in nm: 0 is the bare substrate; beyond ~2 µm the colours of a film
+# wash out to white within the 3 nm spectral sampling.
+Thickness = Annotated[float, Field(ge=0.0, le=2000.0)]
+# Pitch in µm: 0.2 (no visible first order below) to 20 (orders crowd the specular).
+Pitch = Annotated[float, Field(ge=0.2, le=20.0)]
+Orders = Annotated[int, Field(ge=1, le=8)]
+# Groove depth in nm: the phase grating's efficiency J_m(a)²; the Bessel series
+# in the shader is accurate in fp32 to a = 2π·depth/380 nm ≈ 6.6.
+Depth = Annotated[float, Field(ge=0.0, le=400.0)]
+
+
+def about(group: str, unit: str | None = None, **applies: tuple[str, ...]) -> dict[str, Any]:
+    """A field's schema extras: its page group, unit, and the selector values it is read
+    under (none: always)."""
+    extra: dict[str, Any] = {"x-group": group}
+    if unit is not None:
+        extra["x-unit"] = unit
+    if applies:
+        extra["x-applies"] = {name: list(values) for name, values in applies.items()}
+    return extra
+
+
+PHYSICAL, MATERIAL = "physical", "material"
+FILM, GRATING, ROTATION = ("thin-film",), ("grating",), ("rotation",)
+
+
+class Material(BaseModel):
+    """A fully specified material, as the renderer consumes it."""
+
+    model_config = STRICT
+
+    iridescence: IridescenceName = Field(
+        "rotation", json_schema_extra=about(PHYSICAL),
+        description="Colour source: 'rotation' (the paper's rotated MDF, eq. 2), 'thin-film' "
+        "(Airy reflectance of a film) or 'grating' (1-D reflection grating along the tangent).")
+    film_ior: FilmIor = Field(
+        1.3, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="Thin film's refractive index (KHR iridescenceIor), 1 … 3.")
+    film_thickness_min: Thickness = Field(
+        100.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=FILM),
+        description="Film thickness in nm where the thickness field is 0 "
+        "(KHR iridescenceThicknessMinimum), 0 … 2000.")
+    film_thickness_max: Thickness = Field(
+        400.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=FILM),
+        description="Film thickness in nm where the thickness field is 1, and everywhere "
+        "without a field (KHR iridescenceThicknessMaximum), 0 … 2000.")
+    substrate_ior: SubstrateIor = Field(
+        1.5, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="Refractive index under the film (water 1.33, glass 1.5, air 1 for a "
+        "soap film), 1 … 4.")
+    grating_pitch: Pitch = Field(
+        1.6, json_schema_extra=about(PHYSICAL, "µm", iridescence=GRATING),
+        description="Grating period in µm across the grooves (CD 1.6, DVD 0.74), 0.2 … 20.")
+    grating_orders: Orders = Field(
+        3, json_schema_extra=about(PHYSICAL, iridescence=GRATING),
+        description="Highest diffraction order m summed (±1 … ±m, plus the specular m = 0), "
+        "1 … 8.")
+    grating_depth: Depth = Field(
+        150.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=GRATING),
+        description="Groove depth in nm: sets each order's efficiency J_m(a)², 0 … 400.")
+    mdf: MdfName = Field(
+        "multipeak", json_schema_extra=about(MATERIAL, iridescence=ROTATION),
+        description="Microfacet distribution: 'ashikhmin' (eq. 1) or 'multipeak' (eqs. 3-4).")
+    ex: Exponent = Field(
+        100.0, json_schema_extra=about(MATERIAL, mdf=("ashikhmin",)),
+        description="Ashikhmin-Shirley exponent along the tangent (eq. 1), 0 … 1e6.")
+    ey: Exponent = Field(
+        10.0, json_schema_extra=about(MATERIAL, mdf=("ashikhmin",)),
+        description="Ashikhmin-Shirley exponent along the bitangent (eq. 1), 0 … 1e6.")
+    mu_f: Frequency = Field(
+        8.5, json_schema_extra=about(MATERIAL, mdf=("multipeak",), iridescence=ROTATION),
+        description="Multi-peak frequency: rings across the MDF disc (eq. 4), 0 … 1000.")
+    alpha: Anisotropy = Field(
+        2.0, json_schema_extra=about(MATERIAL, mdf=("multipeak",), iridescence=ROTATION),
+        description="Multi-peak anisotropy along the tangent (eq. 4), 0 … 1000.")
+    beta: Anisotropy = Field(
+        1.2, json_schema_extra=about(MATERIAL, mdf=("multipeak",), iridescence=ROTATION),
+        description="Multi-peak anisotropy along the bitangent (eq. 4), 0 … 1000.")
+    theta1: Angle = Field(
+        0.1, json_schema_extra=about(MATERIAL, "rad", iridescence=ROTATION),
+        description="Rotation of the green channel's MDF in radians (eq. 2), -2π … 2π.")
+    theta2: Angle = Field(
+        0.2, json_schema_extra=about(MATERIAL, "rad", iridescence=ROTATION),
+        description="Rotation of the blue channel's MDF in radians (eq. 2), -2π … 2π.")
+    kd: Weight = Field(0.0, json_schema_extra=about(MATERIAL),
+                       description="Diffuse weight, 0 … 100.")
+    ks: Weight = Field(1.0, json_schema_extra=about(MATERIAL),
+                       description="Specular weight, 0 … 100.")
+    albedo: tuple[Unit, Unit, Unit] = Field(
+        (0.5, 0.5, 0.5), json_schema_extra=about(MATERIAL),
+        description="Diffuse colour, linear RGB, each 0 … 1.")
+    f0: Unit = Field(
+        1.0, json_schema_extra=about(MATERIAL),
+        description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off).")
+
+
+MATERIAL_FIELDS = tuple(Material.model_fields)
+
+
+def _optional(name: str) -> Any:
+    """``Material``'s field ``name`` as an override: the same type, range, description and
+    extras, ``None`` by default."""
+    field = Material.model_fields[name]
+    annotation = Annotated[(field.annotation, *field.metadata)] if field.metadata else \
+        field.annotation
+    return (annotation | None, Field(None, description=field.description,
+                                     json_schema_extra=field.json_schema_extra))
+
+
+# Generated, so that a new material field is one declaration in ``Material``.
+MaterialFields: type[BaseModel] = create_model(
+    "MaterialFields", __config__=STRICT, __doc__='Material parameters; ``None`` means "take '
+    'the preset\'s value".', **{name: _optional(name) for name in MATERIAL_FIELDS})

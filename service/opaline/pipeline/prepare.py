@@ -1,0 +1,81 @@
+"""The first stage of every request: from fields to a job that is ready to render.
+
+``prepare`` finds the scene (the preset, drawing the request's mesh if it names
+one), checks the environment's name, resolves the request once, checks the
+deployment's limits and names the result: its cache key and, on demand, its
+canonical URL. Nothing here touches GL, so the HTTP process prepares requests
+itself and hands only the prepared job to a worker.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from opaline.model.params import RenderRequest
+from opaline.model.presets import Preset, get_preset
+from opaline.model.request import Job, resolve
+from opaline.pipeline.canonical import canonical_query, canonical_url
+from opaline.pipeline.limits import Limits, check_limits
+from opaline.scene.environments import EnvironmentMapError, check_name
+
+# How a request's mesh becomes a preset: a file on this machine (CLI, Python, batches) or
+# an upload's id (HTTP). Given the request and the preset it names.
+MeshResolver = Callable[[RenderRequest, Preset], Preset]
+
+
+class UnknownEnvironment(EnvironmentMapError, LookupError):
+    """An environment name that is neither built in nor a file of the environments folder."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """What a request is prepared against where it runs."""
+
+    limits: Limits
+    meshes: MeshResolver
+    environments_dir: Path | None = None
+    # False where another machine renders (``batch --server``): its folder decides.
+    check_environments: bool = True
+
+
+@dataclass(frozen=True)
+class Prepared:
+    request: RenderRequest
+    preset: Preset  # the scene drawn: the mesh preset when the request names a mesh
+    job: Job
+    key: str
+
+    def query(self) -> dict[str, str]:
+        """The canonical GET query's fields, spelled, without ``rev``."""
+        return canonical_query(self.job, self.preset, self.request)
+
+    def url(self) -> str:
+        return canonical_url(self.query(), self.key)
+
+    def with_job(self, job: Job) -> Prepared:
+        """The same scene drawing another job (a turntable's frame), keyed anew."""
+        return replace(self, job=job, key=job.cache_key(self.preset.scene_key()))
+
+
+def scene(request: RenderRequest, context: Context) -> Preset:
+    """The preset a request draws (its mesh's, if it names one), after checking that its
+    environment exists: names are the built-ins plus the files of a folder, which the schema
+    cannot list, so an unknown one is refused like an unknown preset."""
+    preset = get_preset(request.preset)
+    if request.mesh is not None:
+        preset = context.meshes(request, preset)
+    if request.environment is not None and context.check_environments:
+        try:
+            check_name(request.environment, context.environments_dir)
+        except EnvironmentMapError as exc:
+            raise UnknownEnvironment(str(exc)) from None
+    return preset
+
+
+def prepare(request: RenderRequest, context: Context) -> Prepared:
+    preset = scene(request, context)
+    job = resolve(request, preset)
+    check_limits(job, context.limits)
+    return Prepared(request, preset, job, job.cache_key(preset.scene_key()))
