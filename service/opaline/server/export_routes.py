@@ -5,19 +5,19 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Query, Request
+from fastapi import APIRouter, Query, Request
 from fastapi.responses import Response
 
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset
 from opaline.model.request import Job, content_key, resolve
+from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES
 from opaline.server.queries import RenderQuery, parse_body
 from opaline.server.render_routes import BODY, RENDER_RESPONSES, scene_preset
-from opaline.server.service import Service, get_service
+from opaline.server.service import Service
 from opaline.workers.export_task import GlbTask, GlslTask
 
-ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 

@@ -33,18 +33,15 @@ from opaline.server.canonical import (
     is_canonical,
     mdf_url,
 )
+from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, LimitError, Problem, UnknownEnvironment
 from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.query_params import documented, query_model
-from opaline.server.service import Service, get_service
+from opaline.server.service import Service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
-
-ServiceDep = Annotated[Service, Depends(get_service)]
-
-
 
 
 def _over_limit(name: str, value: int, limit: int) -> str:
@@ -111,8 +108,7 @@ def scene_preset(request: Request, svc: Service, params: RenderRequest) -> Prese
     cannot list, so an unknown one is 404 ``unknown_environment`` (as presets are)."""
     preset = get_preset(params.preset)
     if params.mesh is not None:
-        preset = request.app.state.meshes.preset(params, preset,
-                                                 svc.settings.mesh_max_triangles)
+        preset = svc.meshes.preset(params, preset, svc.settings.mesh_max_triangles)
     if params.environment is not None:
         try:
             check_name(params.environment, svc.settings.environments_dir)
