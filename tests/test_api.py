@@ -19,7 +19,8 @@ from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.model.request import TIERS
 from opaline.server.api import WEB_DIR, create_app, mount_web
-from opaline.server.errors import HTTP_REASONS, PUBLIC_ERRORS
+from opaline.errors import PublicError
+from opaline.server.errors import HTTP_REASONS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
 from worker_helpers import BrokenRenderer, EchoTask, GateTask, no_gl
@@ -107,7 +108,10 @@ def test_metrics_exposition(client):
 
 def test_every_rejection_reason_is_exposed_from_the_start():
     """Each reason the error handlers count is on /metrics at 0 before the first rejection."""
-    counted = {reason for _, reason in PUBLIC_ERRORS.values()} | set(HTTP_REASONS.values())
+    def public(cls: type[PublicError]) -> set[type[PublicError]]:
+        return {cls}.union(*(public(sub) for sub in cls.__subclasses__()))
+
+    counted = {error.reason for error in public(PublicError)} | set(HTTP_REASONS.values())
     # "budget_with_tier" is the validation handlers' own code for that one cross-field rule.
     assert counted | {"error", "budget_with_tier"} == set(REJECT_REASONS)
 

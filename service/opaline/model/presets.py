@@ -17,6 +17,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from opaline.errors import PublicError
 from opaline.model.params import STRICT, RenderFields, Unit, describe_errors
 from opaline.resources import presets_dir
 from opaline.scene import geometry, meshfile, normalmaps, thickness
@@ -159,7 +160,9 @@ def all_presets() -> dict[str, Preset]:
     return found
 
 
-class UnknownPreset(KeyError):
+class UnknownPreset(PublicError, KeyError):
+    status, reason = 404, "unknown_preset"
+
     def __init__(self, name: str) -> None:
         self.name = name
         super().__init__(name)

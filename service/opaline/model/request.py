@@ -12,6 +12,7 @@ import json
 from dataclasses import asdict, dataclass
 
 from opaline import __version__
+from opaline.errors import PublicError
 from opaline.model.auto import DEFAULT_MAX_FLIP, Pick, pick
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
 from opaline.model.presets import Preset, get_preset
@@ -30,8 +31,10 @@ BASE_DEFAULTS = {
 }
 
 
-class CostError(ValueError):
+class CostError(PublicError, ValueError):
     """The request would cost more than the configured budget."""
+
+    status, reason = 422, "cost"
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import asyncio
 import os
 from collections import OrderedDict
 from contextlib import asynccontextmanager
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
 from opaline.model.turntable import TurntableRequest
 from opaline.server.access import Access
+from opaline.server.body_limit import BodyLimit
 from opaline.server.cache import ImageCache
 from opaline.server.connections import STATS as CONNECTION_STATS
 from opaline.server.deps import ServiceDep, SettingsDep
@@ -194,7 +196,10 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.state.meshes = MeshStore(settings)
     app.state.turntables = OrderedDict()  # turntable_routes.Turntable by id, latest last
     app.state.turntable_lanes = asyncio.Semaphore(settings.workers)
-    install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
+                       on_reject=partial(metrics.reject, "too_large"),
+                       paths={"/v1/meshes": settings.mesh_max_bytes})
+    install(app)
     app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)
     app.add_middleware(Access, settings=settings, on_reject=metrics.reject)
     app.add_middleware(SecurityHeaders)

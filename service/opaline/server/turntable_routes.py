@@ -193,7 +193,7 @@ async def turntable_get(turntable_id: str, found: TurntablesDep) -> TurntableSta
 async def turntable_result(turntable_id: str, found: TurntablesDep) -> Response:
     entry = _entry(found, turntable_id)
     if entry.state == "failed" and entry.failure is not None:
-        raise entry.failure  # its own public status and reason (errors.PUBLIC_ERRORS)
+        raise entry.failure  # its own public status and reason (a PublicError)
     if entry.state != "done" or entry.data is None:
         raise StillRendering(f"still rendering: {entry.done} of {entry.frames} frames done")
     headers = {"Content-Disposition": f'inline; filename="turntable{EXTENSIONS[entry.fmt]}"'}
