@@ -64,6 +64,8 @@ class Busy(PublicError):
 
     status, reason, retry_later = 429, "busy", True
 
+    retry_after_s: float
+
     def __init__(self, message: str, retry_after_s: float = 1.0) -> None:
         super().__init__(message)
         self.retry_after_s = retry_after_s

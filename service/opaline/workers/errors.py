@@ -10,6 +10,8 @@ class Overloaded(PublicError):
 
     status, reason, retry_later = 503, "queue_full", True
 
+    retry_after_s: float
+
     def __init__(self, message: str, retry_after_s: float = 1.0) -> None:
         super().__init__(message)
         self.retry_after_s = retry_after_s
