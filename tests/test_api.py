@@ -15,14 +15,15 @@ from fastapi import FastAPI
 from fastapi.testclient import TestClient
 from PIL import Image
 
+from opaline.errors import PublicError
 from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.model.tiers import TIERS
 from opaline.server.api import WEB_DIR, create_app, mount_web
-from opaline.server.errors import HTTP_REASONS, PUBLIC_ERRORS
+from opaline.server.errors import HTTP_REASONS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
-from worker_helpers import BrokenRenderer, EchoTask, GateTask, no_gl
+from worker_helpers import BrokenRenderer, EchoTask, GateTask, LostContextRenderer, no_gl
 
 pytestmark = pytest.mark.gl
 
@@ -49,6 +50,14 @@ def make_client(backend, **overrides) -> TestClient:
 def sample(client: TestClient, name: str, labels: dict[str, str] | None = None) -> float:
     value = client.app.state.metrics.registry.get_sample_value(name, labels or {})
     return value or 0.0
+
+
+def scraped(client: TestClient, name: str) -> float:
+    """The value of an unlabelled sample as GET /metrics shows it."""
+    for line in client.get("/metrics").text.splitlines():
+        if line.startswith(name + " "):
+            return float(line.split()[1])
+    raise AssertionError(f"{name} is not on /metrics")
 
 
 def occupy(client: TestClient, folder, key: str = "gate") -> GateTask:
@@ -107,7 +116,10 @@ def test_metrics_exposition(client):
 
 def test_every_rejection_reason_is_exposed_from_the_start():
     """Each reason the error handlers count is on /metrics at 0 before the first rejection."""
-    counted = {reason for _, reason in PUBLIC_ERRORS.values()} | set(HTTP_REASONS.values())
+    def public(cls: type[PublicError]) -> set[type[PublicError]]:
+        return {cls}.union(*(public(sub) for sub in cls.__subclasses__()))
+
+    counted = {error.reason for error in public(PublicError)} | set(HTTP_REASONS.values())
     # "budget_with_tier" is the validation handlers' own code for that one cross-field rule.
     assert counted | {"error", "budget_with_tier"} == set(REJECT_REASONS)
 
@@ -427,7 +439,25 @@ def test_render_failure_is_500_without_the_log(backend, caplog):
         assert "incident" in problems(response)[0]
         assert "SECRET" not in response.text
         assert client.get("/healthz").status_code == 200
+        assert scraped(client, "opaline_render_failures_total") == 1
+        assert scraped(client, "opaline_context_restarts_total") == 0  # a shader error spares it
     assert "SECRET-COMPILE-LOG" in caplog.text
+
+
+def test_a_lost_context_is_counted_and_made_anew(backend):
+    """A render that raises past the shader (a lost context) answers 500, counts as a render
+    failure, and its worker's context is made anew, counted on /metrics, before it is ready."""
+    app = create_app(Settings(gl_backend=backend, warmup=False, calibrate=False),
+                     renderer_factory=partial(LostContextRenderer, backend))
+    with TestClient(app) as client:
+        assert scraped(client, "opaline_context_restarts_total") == 0
+        assert client.get(f"/v1/render?{SMALL}").status_code == 500
+        assert scraped(client, "opaline_render_failures_total") == 1
+        end = time.monotonic() + WAIT
+        while scraped(client, "opaline_context_restarts_total") < 1 and time.monotonic() < end:
+            time.sleep(0.05)
+        assert scraped(client, "opaline_context_restarts_total") == 1
+        assert client.get("/readyz").json()["workers"][0]["restarts"] == 1
 
 
 def test_shutdown_releases_the_workers(backend):

@@ -148,6 +148,7 @@ def test_a_crashed_worker_is_replaced_and_its_job_answered(make_pool):
         pool.submit("crash", CrashTask()).future.result(WAIT)
     wait_until(lambda: pool.status()[0]["state"] == "ready")
     assert pool.status()[0]["pid"] != before and pool.status()[0]["restarts"] == 1
+    assert pool.counters["context_restarts"] == 1
     assert pool.submit("after", EchoTask(b"ok")).future.result(WAIT) == b"ok"
 
 
@@ -180,6 +181,7 @@ def test_workers_are_recycled_after_max_renders(make_pool):
         pool.submit(f"job{i}", EchoTask()).future.result(WAIT)
     wait_until(lambda: pool.status()[0]["pid"] not in (first, None))
     assert pool.counters["recycles"] >= 1
+    assert pool.counters["context_restarts"] == 0  # a recycle follows no failure
 
 
 def test_workers_are_recycled_past_their_memory_limit(make_pool):

@@ -90,6 +90,13 @@ class BrokenRenderer(Renderer):
         raise ShaderError("surface.glsl:12: error: SECRET-COMPILE-LOG")
 
 
+class LostContextRenderer(Renderer):
+    """Draws nothing: every render raises as a lost GL context does."""
+
+    def render(self, job, preset=None, all_features=False, should_stop=None):
+        raise RuntimeError("GL_CONTEXT_LOST")
+
+
 def null_renderer():
     """A renderer without GL, for pool tests that never draw."""
     return NullRenderer()

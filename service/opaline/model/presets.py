@@ -17,6 +17,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from opaline.errors import PublicError
 from opaline.model.material import Unit
 from opaline.model.params import STRICT, RenderFields, describe_errors
 from opaline.resources import presets_dir
@@ -160,7 +161,9 @@ def all_presets() -> dict[str, Preset]:
     return found
 
 
-class UnknownPreset(KeyError):
+class UnknownPreset(PublicError, KeyError):
+    status, reason = 404, "unknown_preset"
+
     def __init__(self, name: str) -> None:
         self.name = name
         super().__init__(name)

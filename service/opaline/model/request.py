@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from opaline import __version__
+from opaline.errors import PublicError
 from opaline.model.auto import DEFAULT_MAX_FLIP, pick
 from opaline.model.params import MATERIAL_FIELDS, Material, RenderFields, RenderRequest
 from opaline.model.presets import Preset, get_preset
@@ -31,8 +32,10 @@ BASE_DEFAULTS = {
 }
 
 
-class CostError(ValueError):
+class CostError(PublicError, ValueError):
     """The request would cost more than the configured budget."""
+
+    status, reason = 422, "cost"
 
 
 @dataclass(frozen=True)

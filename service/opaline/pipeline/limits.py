@@ -9,16 +9,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from opaline.errors import PublicError
 from opaline.model.request import Job, check_cost
 from opaline.output.formats import HAS_ALPHA
 
 
-class LimitError(ValueError):
+class LimitError(PublicError, ValueError):
     """A request within the parameter ranges but over this service's configured limits."""
+
+    status, reason = 422, "limit"
 
     def __init__(self, problems: list[str]) -> None:
         super().__init__("; ".join(problems))
         self.problems = problems
+
+    def lines(self) -> list[str]:
+        return self.problems
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from opaline.errors import PublicError
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, resolve
@@ -25,8 +26,10 @@ from opaline.scene.environments import EnvironmentMapError, check_name
 MeshResolver = Callable[[RenderRequest, Preset], Preset]
 
 
-class UnknownEnvironment(EnvironmentMapError, LookupError):
+class UnknownEnvironment(PublicError, EnvironmentMapError, LookupError):
     """An environment name that is neither built in nor a file of the environments folder."""
+
+    status, reason = 404, "unknown_environment"
 
 
 @dataclass(frozen=True)

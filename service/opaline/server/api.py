@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import asyncio
 import os
+from collections import OrderedDict
 from contextlib import asynccontextmanager
+from functools import partial
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, FastAPI
+from fastapi import APIRouter, FastAPI
 from fastapi.responses import FileResponse, RedirectResponse, Response
 from pydantic import BaseModel
 
@@ -29,8 +31,10 @@ from opaline.model.tiers import TIERS
 from opaline.model.turntable import TurntableRequest
 from opaline.pipeline.prepare import prepare
 from opaline.server.access import Access
+from opaline.server.body_limit import BodyLimit
 from opaline.server.cache import ImageCache
 from opaline.server.connections import STATS as CONNECTION_STATS
+from opaline.server.deps import ServiceDep, SettingsDep
 from opaline.server.docs import SecurityHeaders, mount_docs
 from opaline.server.errors import ERROR_RESPONSES, Problem, install
 from opaline.server.export_routes import router as export_router
@@ -40,7 +44,6 @@ from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness, TierInfo
-from opaline.server.service import Service, SettingsDep, get_service
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.factory import RendererFactory
@@ -48,7 +51,6 @@ from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import PRIVATE, ImageTask
 
 WEB_DIR = Path(__file__).resolve().parent / "web"
-ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 __all__ = ["SettingsDep", "WEB_DIR", "create_app", "mount_web"]
@@ -199,7 +201,12 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
     app.state.meshes = MeshStore(settings)
-    install(app, settings.max_body_bytes, metrics, {"/v1/meshes": settings.mesh_max_bytes})
+    app.state.turntables = OrderedDict()  # turntable_routes.Turntable by id, latest last
+    app.state.turntable_lanes = asyncio.Semaphore(settings.workers)
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
+                       on_reject=partial(metrics.reject, "too_large"),
+                       paths={"/v1/meshes": settings.mesh_max_bytes})
+    install(app)
     app.add_middleware(Methods, routes_of=app, on_reject=metrics.reject)
     app.add_middleware(Access, settings=settings, on_reject=metrics.reject)
     app.add_middleware(SecurityHeaders)

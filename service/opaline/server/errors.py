@@ -5,14 +5,14 @@ one line per problem, 400 for a body that does not parse, 404 for an unknown
 preset, mesh, environment, turntable or path, 413 for a body over the limit, 409
 for a turntable still rendering, 429 and 503 with Retry-After, 500 with a pointer
 to the server log (the traceback and any shader log go only there).
-Each answer is counted under its reason. ``install`` puts the handlers and the
-body limit on an app.
+Each failure of this package is an ``opaline.errors.PublicError`` that names its
+own status, reason and lines; ``on_public_error`` answers them all. Each answer is
+counted under its reason. ``install`` puts the handlers on an app (the body limit is
+``body_limit.BodyLimit``).
 """
 
 from __future__ import annotations
 
-import math
-from functools import partial
 from typing import Any
 
 from fastapi import FastAPI, Request
@@ -21,64 +21,37 @@ from fastapi.responses import JSONResponse, Response
 from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException
 from starlette.requests import ClientDisconnect
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from opaline.errors import PublicError
 from opaline.model.params import RenderRequest, describe_errors
-from opaline.model.presets import UnknownPreset
-from opaline.model.request import CostError
-from opaline.pipeline.limits import LimitError
-from opaline.pipeline.prepare import UnknownEnvironment
-from opaline.server.meshstore import InvalidMesh, MeshTooLarge, UnknownMesh
-from opaline.server.metrics import REJECT_REASONS, Metrics
-from opaline.server.queries import Malformed, MdfQuery
-from opaline.workers.errors import (
-    Cancelled,
-    DeadlineExceeded,
-    InvalidInput,
-    Overloaded,
-    RenderFailed,
-    TooSlow,
-    Unavailable,
-)
+from opaline.pipeline.limits import LimitError as LimitError
+from opaline.pipeline.prepare import UnknownEnvironment as UnknownEnvironment
+from opaline.server.metrics import REJECT_REASONS
+from opaline.server.queries import MdfQuery
 
 
-class UnknownTurntable(LookupError):
+class UnknownTurntable(PublicError, LookupError):
     """A turntable id this server does not know (never started, or forgotten)."""
 
+    status, reason = 404, "unknown_turntable"
 
-class StillRendering(Exception):
+
+class StillRendering(PublicError):
     """The turntable's animation is not ready yet (409)."""
 
+    status, reason = 409, "rendering"
 
-class Busy(Exception):
+
+class Busy(PublicError):
     """As many turntables as the service runs at once are running (429 with Retry-After)."""
+
+    status, reason, retry_later = 429, "busy", True
+
+    retry_after_s: float
 
     def __init__(self, message: str, retry_after_s: float = 1.0) -> None:
         super().__init__(message)
         self.retry_after_s = retry_after_s
-
-
-PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
-    Malformed: (400, "malformed"),
-    UnknownPreset: (404, "unknown_preset"),
-    CostError: (422, "cost"),
-    LimitError: (422, "limit"),
-    TooSlow: (422, "too_slow"),
-    ValidationError: (422, "invalid"),
-    Overloaded: (503, "queue_full"),
-    DeadlineExceeded: (503, "deadline"),
-    Unavailable: (503, "unavailable"),
-    Cancelled: (503, "cancelled"),
-    RenderFailed: (500, "render_failed"),
-    InvalidInput: (422, "invalid"),
-    UnknownMesh: (404, "unknown_mesh"),
-    MeshTooLarge: (413, "too_large"),
-    InvalidMesh: (422, "invalid_mesh"),
-    UnknownEnvironment: (404, "unknown_environment"),
-    UnknownTurntable: (404, "unknown_turntable"),
-    StillRendering: (409, "rendering"),
-    Busy: (429, "busy"),
-}
 
 
 # The error bodies as the OpenAPI document shows them
@@ -151,23 +124,18 @@ async def on_invalid(request: Request, exc: RequestValidationError) -> JSONRespo
     return problem(422, code, _validation_lines(list(exc.errors()), model))
 
 
-async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
-    status, reason = next(v for k, v in PUBLIC_ERRORS.items() if isinstance(exc, k))
-    if isinstance(exc, ValidationError):
-        reason = validation_code(exc.errors())
-    state = request.app.state
-    state.metrics.reject(reason)
-    if isinstance(exc, ValidationError):
-        return problem(status, reason, describe_errors(exc))
-    if isinstance(exc, LimitError):
-        return problem(status, reason, exc.problems)
-    if isinstance(exc, RenderFailed):
-        return problem(status, reason, f"{exc}: the details are in the server log")
-    if status in (429, 503):
-        wait = getattr(exc, "retry_after_s", state.settings.retry_after_s)
-        retry = str(max(state.settings.retry_after_s, math.ceil(wait)))
-        return problem(status, reason, f"{exc}; retry later", headers={"Retry-After": retry})
-    return problem(status, reason, str(exc))
+async def on_public_error(request: Request, exc: PublicError) -> JSONResponse:
+    """Any failure of this package, as it says it is answered."""
+    settings = request.app.state.settings
+    request.app.state.metrics.reject(exc.reason)
+    return problem(exc.status, exc.reason, exc.lines(), exc.headers(settings.retry_after_s))
+
+
+async def on_invalid_model(request: Request, exc: ValidationError) -> JSONResponse:
+    """A model that a route validated itself (a strictly parsed body)."""
+    reason = validation_code(exc.errors())
+    request.app.state.metrics.reject(reason)
+    return problem(422, reason, describe_errors(exc))
 
 
 async def on_http_error(request: Request, exc: HTTPException) -> JSONResponse:
@@ -189,51 +157,11 @@ async def on_crash(request: Request, exc: Exception) -> JSONResponse:
     return problem(500, "error", "internal error: the details are in the server log")
 
 
-class BodyLimit:
-    """413 for a body over ``limit`` bytes: by its Content-Length, or counted as it arrives."""
-
-    def __init__(self, app: ASGIApp, limit: int, on_reject: Any,
-                 paths: dict[str, int] | None = None) -> None:
-        self.app, self.limit, self.on_reject = app, limit, on_reject
-        self.paths = paths or {}  # routes whose body is a file, with their own limit
-
-    def _refuse(self, limit: int, count: bool = True) -> str:
-        """Count the rejection (unless the error handler will); the message to answer it with."""
-        if count:
-            self.on_reject()
-        return f"request body over the {limit} byte limit"
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        limit = self.paths.get(scope.get("path", ""), self.limit)
-        declared = dict(scope["headers"]).get(b"content-length", b"")
-        if declared.isdigit() and int(declared) > limit:
-            await problem(413, "too_large", self._refuse(limit))(scope, receive, send)
-            return
-        seen = 0
-
-        async def counted() -> Message:
-            nonlocal seen
-            message = await receive()
-            seen += len(message.get("body", b""))
-            if seen > limit:
-                # The route's body reader re-raises it; on_http_error answers and counts it
-                raise HTTPException(413, self._refuse(limit, count=False))
-            return message
-
-        await self.app(scope, counted, send)
-
-
-def install(app: FastAPI, max_body_bytes: int, metrics: Metrics,
-            file_limits: dict[str, int] | None = None) -> None:
-    """The body limit and a handler for every public error, each counting its rejections."""
-    app.add_middleware(BodyLimit, limit=max_body_bytes,
-                       on_reject=partial(metrics.reject, "too_large"), paths=file_limits)
+def install(app: FastAPI) -> None:
+    """A handler for every public error, each counting its rejections."""
     app.add_exception_handler(RequestValidationError, on_invalid)
+    app.add_exception_handler(ValidationError, on_invalid_model)
+    app.add_exception_handler(PublicError, on_public_error)
     app.add_exception_handler(HTTPException, on_http_error)
     app.add_exception_handler(ClientDisconnect, on_gone)
     app.add_exception_handler(Exception, on_crash)
-    for exc_type in PUBLIC_ERRORS:
-        app.add_exception_handler(exc_type, on_public_error)

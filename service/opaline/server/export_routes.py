@@ -5,19 +5,18 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Query, Request
+from fastapi import APIRouter, Query, Request
 from fastapi.responses import Response
 
 from opaline.model.params import RenderRequest
 from opaline.model.request import content_key
 from opaline.pipeline.prepare import prepare
+from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES
 from opaline.server.queries import RenderQuery, parse_body
 from opaline.server.render_routes import BODY, RENDER_RESPONSES
-from opaline.server.service import Service, get_service
 from opaline.workers.export_task import GlbTask, GlslTask
 
-ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 

@@ -12,19 +12,18 @@ draws.
 from __future__ import annotations
 
 import json
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Request
 from pydantic import BaseModel, Field
 
+from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, Problem
-from opaline.server.meshstore import InvalidMesh, MeshStore
+from opaline.server.meshstore import InvalidMesh
 from opaline.server.render_routes import client_gone
-from opaline.server.service import Service, get_service
 from opaline.workers.errors import InvalidInput
 from opaline.workers.mesh_tasks import MeshCheckTask
 
-ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 
 
@@ -36,10 +35,6 @@ class MeshInfo(BaseModel):
     uvs: bool = Field(description="Whether the mesh has UV coordinates (tangents from them).")
     tangents: str = Field(description="The tangent field an 'auto' request gets.")
     bounds: list[list[float]] = Field(description="Lower and upper corner of its bounding box.")
-
-
-def store_of(request: Request) -> MeshStore:
-    return request.app.state.meshes
 
 
 MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
@@ -61,7 +56,7 @@ async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     if not data:
         raise InvalidMesh("empty body: send the mesh file (glTF/GLB, OBJ, PLY or STL) "
                           "as the request body")
-    store = store_of(request)
+    store = svc.meshes
     mesh_id = store.put(data)
     max_triangles = svc.settings.mesh_max_triangles
     task = MeshCheckTask(str(store.path_of(mesh_id)), max_triangles)

@@ -19,6 +19,7 @@ import weakref
 from collections import OrderedDict
 from pathlib import Path
 
+from opaline.errors import PublicError
 from opaline.model.meshes import file_digest, mesh_preset
 from opaline.model.presets import Preset
 from opaline.model.scene_fields import SceneFields
@@ -28,7 +29,9 @@ MESH_ID = re.compile(r"^[0-9a-f]{32}$")
 SUFFIX = ".mesh"  # the format is in the bytes; the worker sniffs it
 
 
-class UnknownMesh(KeyError):
+class UnknownMesh(PublicError, KeyError):
+    status, reason = 404, "unknown_mesh"
+
     def __init__(self, name: str) -> None:
         self.name = name
         super().__init__(name)
@@ -38,13 +41,17 @@ class UnknownMesh(KeyError):
                 "upload it with POST /v1/meshes and use the id it answers")
 
 
-class InvalidMesh(ValueError):
+class InvalidMesh(PublicError, ValueError):
     """The uploaded bytes are not a mesh this service reads, or one over its limits (422
     ``invalid_mesh``: the OpenAPI schema of the body, any binary, cannot say which are)."""
 
+    status, reason = 422, "invalid_mesh"
 
-class MeshTooLarge(ValueError):
+
+class MeshTooLarge(PublicError, ValueError):
     """The upload is over ``mesh_max_bytes`` (413)."""
+
+    status, reason = 413, "too_large"
 
 
 class MeshStore:

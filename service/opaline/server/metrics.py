@@ -34,6 +34,9 @@ POOL_COUNTERS = {
                        {"reason": "crash"}),
     "restarts_died": ("opaline_worker_restarts", "", {"reason": "died"}),
     "restarts_watchdog": ("opaline_worker_restarts", "", {"reason": "watchdog"}),
+    "render_failures": ("opaline_render_failures", "Renders that raised (answered 500).", {}),
+    "context_restarts": ("opaline_context_restarts",
+                         "GL contexts released after a failure and made anew.", {}),
     "recycles": ("opaline_worker_recycles", "Workers recycled after max renders or memory.", {}),
     "watchdog_kills": ("opaline_watchdog_kills", "Renders killed past the time limit.", {}),
     "program_evictions": ("opaline_worker_cache_evictions", "Worker cache evictions.",
@@ -71,12 +74,6 @@ class Metrics:
             registry=self.registry)
         self.rejected = Counter(
             "opaline_rejected_requests", "Requests refused, by reason.", ["reason"],
-            registry=self.registry)
-        self.render_failures = Counter(
-            "opaline_render_failures", "Renders that raised (answered 500).",
-            registry=self.registry)
-        self.context_restarts = Counter(
-            "opaline_context_restarts", "GL contexts released after a failure and made anew.",
             registry=self.registry)
         for reason in REJECT_REASONS:
             self.rejected.labels(reason)

@@ -14,6 +14,7 @@ from typing import Any, Literal, TypeVar, Union, get_args, get_origin
 from pydantic import BaseModel, Field, field_validator
 from pydantic_core import from_json, to_json
 
+from opaline.errors import PublicError
 from opaline.model.material import Unit
 from opaline.model.params import (
     MaterialFields,
@@ -70,8 +71,10 @@ class MdfQuery(MaterialFields):
     _wavelengths = field_validator("wavelengths")(wavelengths_ok)
 
 
-class Malformed(ValueError):
+class Malformed(PublicError, ValueError):
     """A body that is not a JSON document: not UTF-8, not JSON, or nested too deep (400)."""
+
+    status, reason = 400, "malformed"
 
 
 Model = TypeVar("Model", bound=BaseModel)

@@ -30,18 +30,15 @@ from opaline.server.canonical import (
     is_canonical,
     mdf_url,
 )
+from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, Problem
 from opaline.server.negotiation import Started, negotiated, server_timing
 from opaline.server.queries import MdfQuery, parse_body
 from opaline.server.query_params import documented, query_model
-from opaline.server.service import Service, get_service
+from opaline.server.service import Service
 from opaline.server.streaming import image_response
 from opaline.settings import Settings
 from opaline.workers.tasks import ImageTask, MdfTask, Task
-
-ServiceDep = Annotated[Service, Depends(get_service)]
-
-
 
 
 def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:

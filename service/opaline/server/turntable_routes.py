@@ -21,9 +21,9 @@ from __future__ import annotations
 import asyncio
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Request
 from fastapi.responses import Response
 from pydantic import BaseModel
 
@@ -31,6 +31,7 @@ from opaline.model.request import content_key
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
 from opaline.output.animation import EXTENSIONS, MEDIA_TYPES
 from opaline.pipeline.prepare import prepare
+from opaline.server.deps import LanesDep, ServiceDep, TurntablesDep
 from opaline.server.errors import (
     ERROR_RESPONSES,
     RETRY_AFTER,
@@ -41,12 +42,11 @@ from opaline.server.errors import (
 )
 from opaline.server.queries import parse_body
 from opaline.server.render_routes import RENDER_RESPONSES
-from opaline.server.service import Service, get_service
+from opaline.server.service import Service
 from opaline.workers.animation_task import AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
 
-ServiceDep = Annotated[Service, Depends(get_service)]
 router = APIRouter()
 KEPT = 64  # finished or running turntables remembered (oldest forgotten first)
 
@@ -75,21 +75,6 @@ class Turntable:
     def status(self) -> TurntableStatus:
         return TurntableStatus(id=self.id, state=self.state, done=self.done, frames=self.frames,
                                error=self.error, result=f"/v1/turntables/{self.id}/result")
-
-
-def registry(request: Request) -> OrderedDict[str, Turntable]:
-    state = request.app.state
-    if not hasattr(state, "turntables"):
-        state.turntables = OrderedDict()
-    return state.turntables
-
-
-def lanes(request: Request, workers: int) -> asyncio.Semaphore:
-    """The frame lanes every turntable shares: one per worker."""
-    state = request.app.state
-    if not hasattr(state, "turntable_lanes"):
-        state.turntable_lanes = asyncio.Semaphore(workers)
-    return state.turntable_lanes
 
 
 async def patiently(svc: Service, key: str, task: Any, deadline: float) -> bytes:
@@ -156,7 +141,8 @@ BODY = {"requestBody": {"required": True, "content": {
 @router.post("/v1/turntables", tags=["turntables"], status_code=202, openapi_extra=BODY,
              responses={**ERROR_RESPONSES, 404: RENDER_404, 429: BUSY},
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
-async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
+async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep,
+                         shared: LanesDep) -> TurntableStatus:
     body = parse_body(await request.body(), TurntableRequest)
     still = prepare(body.still(), svc.context)
     check_turntable_cost(still.job, body.frames, svc.settings.cost_budget)
@@ -168,7 +154,6 @@ async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
                       f"{svc.settings.deadline_s:g} s limit: lower width, height, samples or "
                       "wavelengths (or choose a lower quality)")
     key = content_key({"frames": [k for k, _ in tasks], "fmt": body.animation, "fps": body.fps})
-    found = registry(request)
     entry = found.get(key)
     if entry is None or entry.state == "failed":
         running = sum(t.state == "running" for t in found.values())
@@ -177,7 +162,6 @@ async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
                        "once; retry later", retry_after_s=svc.settings.deadline_s)
         entry = found[key] = Turntable(key, body.frames, body.animation)
         found.move_to_end(key)
-        shared = lanes(request, svc.settings.workers)
         entry.task = asyncio.create_task(run(svc, entry, tasks, body.fps, shared))
         while len(found) > KEPT:
             oldest = found.popitem(last=False)[1]
@@ -186,8 +170,8 @@ async def turntable_post(request: Request, svc: ServiceDep) -> TurntableStatus:
     return entry.status()
 
 
-def _entry(request: Request, turntable_id: str) -> Turntable:
-    entry = registry(request).get(turntable_id)
+def _entry(found: OrderedDict[str, Turntable], turntable_id: str) -> Turntable:
+    entry = found.get(turntable_id)
     if entry is None:
         raise UnknownTurntable(f"turntable {turntable_id!r} is not known here: start it with "
                                "POST /v1/turntables (finished ones are forgotten after 64)")
@@ -197,17 +181,17 @@ def _entry(request: Request, turntable_id: str) -> Turntable:
 @router.get("/v1/turntables/{turntable_id}", tags=["turntables"],
             responses={**ERROR_RESPONSES, 404: UNKNOWN},
             summary="A turntable's progress: frames done of frames")
-async def turntable_get(turntable_id: str, request: Request) -> TurntableStatus:
-    return _entry(request, turntable_id).status()
+async def turntable_get(turntable_id: str, found: TurntablesDep) -> TurntableStatus:
+    return _entry(found, turntable_id).status()
 
 
 @router.get("/v1/turntables/{turntable_id}/result", tags=["turntables"],
             response_class=Response, responses=RESULT_RESPONSES,
             summary="The finished animation (409 while it renders)")
-async def turntable_result(turntable_id: str, request: Request) -> Response:
-    entry = _entry(request, turntable_id)
+async def turntable_result(turntable_id: str, found: TurntablesDep) -> Response:
+    entry = _entry(found, turntable_id)
     if entry.state == "failed" and entry.failure is not None:
-        raise entry.failure  # its own public status and reason (errors.PUBLIC_ERRORS)
+        raise entry.failure  # its own public status and reason (a PublicError)
     if entry.state != "done" or entry.data is None:
         raise StillRendering(f"still rendering: {entry.done} of {entry.frames} frames done")
     headers = {"Content-Disposition": f'inline; filename="turntable{EXTENSIONS[entry.fmt]}"'}

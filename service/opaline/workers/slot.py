@@ -61,6 +61,7 @@ class Slot:
         self.info: dict[str, str] = {}
         self.error = ""
         self.restarts = self.renders = self.total_renders = self.rss_bytes = 0
+        self.lost_context = False  # replaced after a failure; the next context is a restart
         self.job: Job | None = None
         self.job_started = 0.0
         self.opened = threading.Event()
@@ -117,6 +118,9 @@ class Slot:
             self.state = "failed"
             return False
         self.info, self.error, self.state = message[1], "", "ready"
+        if self.lost_context:
+            self.lost_context = False
+            pool.counters["context_restarts"] += 1
         log.info("%s ready (pid %d): %s", self.name, process.pid, self.info)
         return True
 
@@ -187,6 +191,7 @@ class Slot:
     def replace(self, reason: str) -> None:
         """Kill this worker; the thread's loop starts a new one."""
         self.restarts += 1
+        self.lost_context = True
         self.pool.counters[f"restarts_{reason}"] += 1
         self.kill()
         self.state = "starting"
