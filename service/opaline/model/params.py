@@ -26,6 +26,7 @@ from opaline.model import messages
 from opaline.model.messages import field_range as field_range
 from opaline.model.physical_params import PhysicalFields, PhysicalMaterial
 from opaline.model.scene_fields import SceneFields
+from opaline.model.schema_groups import add_groups
 
 TWO_PI = 2.0 * math.pi
 
@@ -191,6 +192,7 @@ class RenderFields(MaterialFields, SceneFields):
 class RenderRequest(RenderFields):
     """A render request: a preset and any fields that override its defaults."""
 
+    model_config = ConfigDict(json_schema_extra=add_groups)
     preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
 
 

@@ -22,9 +22,11 @@ from pydantic import BaseModel
 
 from opaline import __version__
 from opaline.gl.camera import key_light_direction
+from opaline.gl.lighting import ENVIRONMENT_LIGHTS
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
+from opaline.model.tiers import TIERS
 from opaline.model.turntable import TurntableRequest
 from opaline.server.access import Access
 from opaline.server.cache import ImageCache
@@ -76,6 +78,13 @@ async def presets_list() -> list[PresetInfo]:
             responses={404: {"model": Problem, "description": "Unknown preset."}})
 async def presets_one(name: str) -> PresetInfo:
     return preset_info(get_preset(name))
+
+
+@router.get("/v1/tiers", tags=["presets"], summary="The quality tiers and what each sets")
+async def tiers_list() -> list[dict[str, Any]]:
+    # Stand-in until main lists the tiers itself (the page reads them).
+    return [{"name": name, **values, "environment_lights": ENVIRONMENT_LIGHTS[name]}
+            for name, values in TIERS.items()]
 
 
 @router.get("/healthz", tags=["operations"], summary="Liveness: the process answers",
