@@ -43,9 +43,10 @@ from opaline.workers.errors import (
 class LimitError(ValueError):
     """A request within the parameter ranges but over this service's configured limits."""
 
-    def __init__(self, problems: list[str]) -> None:
+    def __init__(self, problems: list[str], fields: list[str | None] | None = None) -> None:
         super().__init__("; ".join(problems))
         self.problems = problems
+        self.fields = fields or [None] * len(problems)  # the field each problem is about
 
 
 class UnknownEnvironment(LookupError):
@@ -94,11 +95,21 @@ PUBLIC_ERRORS: dict[type[Exception], tuple[int, str]] = {
 # The error bodies as the OpenAPI document shows them
 
 
+class FieldProblem(BaseModel):
+    """One line of a 422's detail with the request field it is about."""
+
+    field: str = Field(description="The request field (top level: albedo for albedo.0).")
+    message: str = Field(description="Its line of detail, as written there.")
+
+
 class Problem(BaseModel):
     """Every error answer, whatever its status."""
 
     error: str = Field(description="Why, in one word: " + ", ".join(REJECT_REASONS) + ".")
     detail: list[str] = Field(description="One line per problem: field, value, what is allowed.")
+    fields: list[FieldProblem] = Field(
+        default_factory=list, description="422 only: the problems that are about one request "
+                                          "field, each with its line of detail.")
 
 
 # Reasons of the errors Starlette raises itself (routing, body limit, access control).
@@ -141,11 +152,34 @@ def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> l
     return lines + describe_errors(rest, model)
 
 
+def _field_of(loc: tuple) -> str | None:
+    """The top-level request field of an error location (FastAPI's start with body/query)."""
+    loc = loc[1:] if loc and loc[0] in ("body", "query", "path") else loc
+    return loc[0] if loc and isinstance(loc[0], str) else None
+
+
+def _validation_fields(errors: list[dict[str, Any]], model: type[BaseModel],
+                       lines_of: Any) -> list[dict[str, str]]:
+    """``fields`` of a 422: each error about a field, with the line ``lines_of`` gives it
+    alone (the lines are written one per error, so they are those of ``detail``)."""
+    found = []
+    for err in errors:
+        name = _field_of(tuple(err.get("loc", ())))
+        if name is not None:
+            found.extend({"field": name, "message": line} for line in lines_of([err], model))
+    return found
+
+
 def problem(status: int, reason: str, detail: str | list[str],
-            headers: dict[str, str] | None = None) -> JSONResponse:
-    """The one error body: ``{"error": reason, "detail": [lines]}``."""
+            headers: dict[str, str] | None = None,
+            fields: list[dict[str, str]] | None = None) -> JSONResponse:
+    """The one error body: ``{"error": reason, "detail": [lines]}``; a 422's also has
+    ``fields``, its problems about a request field (``[{"field": name, "message": line}]``)."""
     lines = [detail] if isinstance(detail, str) else detail
-    return JSONResponse({"error": reason, "detail": lines}, status_code=status, headers=headers)
+    body: dict[str, Any] = {"error": reason, "detail": lines}
+    if status == 422:
+        body["fields"] = fields or []
+    return JSONResponse(body, status_code=status, headers=headers)
 
 
 def validation_code(errors: list[Any]) -> str:
@@ -158,7 +192,9 @@ async def on_invalid(request: Request, exc: RequestValidationError) -> JSONRespo
     code = validation_code(list(exc.errors()))
     request.app.state.metrics.reject(code)
     model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
-    return problem(422, code, _validation_lines(list(exc.errors()), model))
+    errors = list(exc.errors())
+    return problem(422, code, _validation_lines(errors, model),
+                   fields=_validation_fields(errors, model, _validation_lines))
 
 
 async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
@@ -168,9 +204,12 @@ async def on_public_error(request: Request, exc: Exception) -> JSONResponse:
     state = request.app.state
     state.metrics.reject(reason)
     if isinstance(exc, ValidationError):
-        return problem(status, reason, describe_errors(exc))
+        return problem(status, reason, describe_errors(exc),
+                       fields=_validation_fields(exc.errors(), RenderRequest, describe_errors))
     if isinstance(exc, LimitError):
-        return problem(status, reason, exc.problems)
+        return problem(status, reason, exc.problems, fields=[
+            {"field": name, "message": line}
+            for name, line in zip(exc.fields, exc.problems, strict=True) if name is not None])
     if isinstance(exc, RenderFailed):
         return problem(status, reason, f"{exc}: the details are in the server log")
     if status in (429, 503):

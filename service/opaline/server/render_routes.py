@@ -52,19 +52,18 @@ def _over_limit(name: str, value: int, limit: int) -> str:
 
 
 def check_limits(job: Job, settings: Settings) -> None:
-    problems = [_over_limit(name, value, limit)
-                for name, value, limit in (("width", job.width, settings.max_width),
-                                           ("height", job.height, settings.max_height))
-                if value > limit]
-    if problems:
-        raise LimitError(problems)
+    over = [(name, value, limit) for name, value, limit in (("width", job.width, settings.max_width),
+                                                           ("height", job.height, settings.max_height))
+            if value > limit]
+    if over:
+        raise LimitError([_over_limit(*args) for args in over], [name for name, _, _ in over])
     check_cost(job, settings.cost_budget)
 
 
 def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     size = min(settings.max_width, settings.max_height)
     if params.size > size:
-        raise LimitError([_over_limit("size", params.size, size)])
+        raise LimitError([_over_limit("size", params.size, size)], ["size"])
     check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
 
 
@@ -133,7 +132,7 @@ async def answer_render(svc: Service, request: Request, params: RenderRequest,
     job, query = canonical_job(resolve(params, preset), preset, params)
     if job.transparent and job.format not in HAS_ALPHA:
         raise LimitError([f"format={job.format} has no alpha channel: transparent=true needs "
-                          "png, png16, webp, webp-lossless or avif"])
+                          "png, png16, webp, webp-lossless or avif"], ["format"])
     check_limits(job, svc.settings)
     key = job.cache_key(preset.scene_key())
     url = canonical_url(query, key)
