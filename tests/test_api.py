@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import logging
+import re
 import threading
 import time
 from functools import partial
@@ -19,6 +20,7 @@ from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.model.request import TIERS
 from opaline.server.api import WEB_DIR, create_app, mount_web
+from opaline.server.docs import SecurityHeaders
 from opaline.server.errors import HTTP_REASONS, PUBLIC_ERRORS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
@@ -527,3 +529,26 @@ def test_quality_auto_says_what_it_picked(client):
     assert answer.headers["X-Opaline-Auto-Target"] == "max_flip=0.05"
     assert "samples=" in answer.headers["X-Opaline-Auto-Setting"]
     assert "X-Opaline-Auto-Target" not in client.get(f"/v1/render?{SMALL}").headers
+
+
+def test_web_modules_are_served_as_javascript_under_the_page_csp():
+    """The page's ES modules come from /static with a JavaScript type (a module of any other
+    type is refused under nosniff), each import names a module of the folder, and index.html
+    loads them with no inline script, which its CSP (script-src 'self') would refuse."""
+    app = FastAPI()
+    app.add_middleware(SecurityHeaders)
+    mount_web(app)
+    modules = sorted(WEB_DIR.glob("*.js"))
+    assert {p.name for p in modules} >= {"main.js", "api.js", "schema.js", "assets.js"}
+    with TestClient(app) as client:
+        page = client.get("/")
+        assert "script-src 'self'" in page.headers["content-security-policy"]
+        assert '<script type="module" src="/static/main.js"></script>' in page.text
+        assert "<script>" not in page.text
+        for path in modules:
+            answer = client.get(f"/static/{path.name}")
+            assert answer.status_code == 200, path.name
+            assert answer.headers["content-type"].split(";")[0] in (
+                "text/javascript", "application/javascript"), answer.headers
+            for name in re.findall(r"from '\./([\w-]+\.js)'", answer.text):
+                assert (WEB_DIR / name).is_file(), (path.name, name)
