@@ -104,7 +104,7 @@ def test_api_key_opens_every_route_and_metrics(client):
 
 @pytest.mark.gl
 def test_probes_page_and_docs_stay_open(client):
-    for path in ("/healthz", "/readyz", "/", "/static/app.js", "/docs", "/openapi.json"):
+    for path in ("/healthz", "/readyz", "/", "/static/main.js", "/docs", "/openapi.json"):
         assert client.get(path).status_code == 200, path
 
 

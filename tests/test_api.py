@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import logging
+import re
 import threading
 import time
 from functools import partial
@@ -20,6 +21,7 @@ from opaline.model.params import RenderFields, field_range
 from opaline.model.presets import all_presets
 from opaline.model.tiers import TIERS
 from opaline.server.api import WEB_DIR, create_app, mount_web
+from opaline.server.docs import SecurityHeaders
 from opaline.server.errors import HTTP_REASONS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.settings import MAX_PIXELS, Settings, get_settings
@@ -68,10 +70,15 @@ def occupy(client: TestClient, folder, key: str = "gate") -> GateTask:
 
 
 def problems(response) -> list[str]:
-    """The lines of an error answer, checking its one shape: {"error": reason, "detail": [...]}."""
+    """The lines of an error answer, checking its one shape: {"error": reason, "detail": [...]},
+    and on a 422 the problems about a field, each a line of detail, under "fields"."""
     body = response.json()
-    assert set(body) == {"error", "detail"} and isinstance(body["error"], str), body
+    shape = {"error", "detail", "fields"} if response.status_code == 422 else {"error", "detail"}
+    assert set(body) == shape and isinstance(body["error"], str), body
     assert all(isinstance(line, str) for line in body["detail"]), body
+    if response.status_code == 422:
+        assert all(set(f) == {"field", "message"} and f["message"] in body["detail"]
+                   for f in body["fields"]), body
     return body["detail"]
 
 
@@ -259,6 +266,18 @@ def test_out_of_range_query_is_422_naming_field_and_range(client, query, field, 
     assert any(field in line and allowed in line for line in lines), lines
 
 
+def test_422_names_the_field_of_each_problem(client):
+    """A 422's "fields" pair each problem about a field with its line (the page routes them
+    to its controls); a line about no field (a missing body's) is in detail only."""
+    body = client.get("/v1/render?mu_f=2000&albedo=0.1,2,0.3&muf=3").json()
+    assert [f["field"] for f in body["fields"]] == ["mu_f", "albedo", "muf"], body
+    assert [f["message"] for f in body["fields"]] == body["detail"]
+    posted = client.post("/v1/render", json={"ks": 200, "albedo": [0.1, 0.2]}).json()
+    assert {f["field"] for f in posted["fields"]} == {"ks", "albedo"}, posted
+    mdf = client.get("/v1/mdf?size=4096").json()
+    assert [f["field"] for f in mdf["fields"]] == ["size"], mdf
+
+
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
 def test_non_finite_query_is_422(client, value):
     """Non-finite numbers in the query string are refused, naming the field."""
@@ -334,6 +353,9 @@ def test_size_over_service_limit_is_422(backend):
         lines = problems(client.get("/v1/render?width=256&height=256"))
         assert any(line.startswith("width=256") and "128" in line for line in lines)
         assert any(line.startswith("height=256") and "96" in line for line in lines)
+        fields = client.get("/v1/render?width=256&height=256").json()["fields"]
+        assert [(f["field"], f["message"]) for f in fields] == list(zip(("width", "height"),
+                                                                         lines, strict=True))
         assert client.get("/v1/mdf?size=200").status_code == 422
 
 
@@ -537,3 +559,26 @@ def test_quality_auto_says_what_it_picked(client):
     assert answer.headers["X-Opaline-Auto-Target"] == "max_flip=0.05"
     assert "samples=" in answer.headers["X-Opaline-Auto-Setting"]
     assert "X-Opaline-Auto-Target" not in client.get(f"/v1/render?{SMALL}").headers
+
+
+def test_web_modules_are_served_as_javascript_under_the_page_csp():
+    """The page's ES modules come from /static with a JavaScript type (a module of any other
+    type is refused under nosniff), each import names a module of the folder, and index.html
+    loads them with no inline script, which its CSP (script-src 'self') would refuse."""
+    app = FastAPI()
+    app.add_middleware(SecurityHeaders)
+    mount_web(app)
+    modules = sorted(WEB_DIR.glob("*.js"))
+    assert {p.name for p in modules} >= {"main.js", "api.js", "schema.js", "assets.js"}
+    with TestClient(app) as client:
+        page = client.get("/")
+        assert "script-src 'self'" in page.headers["content-security-policy"]
+        assert '<script type="module" src="/static/main.js"></script>' in page.text
+        assert "<script>" not in page.text
+        for path in modules:
+            answer = client.get(f"/static/{path.name}")
+            assert answer.status_code == 200, path.name
+            assert answer.headers["content-type"].split(";")[0] in (
+                "text/javascript", "application/javascript"), answer.headers
+            for name in re.findall(r"from '\./([\w-]+\.js)'", answer.text):
+                assert (WEB_DIR / name).is_file(), (path.name, name)

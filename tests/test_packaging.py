@@ -44,6 +44,8 @@ def test_wheel_contains_every_shader_and_preset(wheel):
         assert f"opaline/_presets/{preset.name}" in names
     assert any(name.endswith("entry_points.txt") for name in names)
     assert "opaline/model/quality_table.json" in names  # quality=auto's measurements
+    for source in (PACKAGE / "server" / "web").iterdir():  # the tuning page and its modules
+        assert f"opaline/server/web/{source.name}" in names
 
 
 # -- the runtime import closure --------------------------------------------------------------

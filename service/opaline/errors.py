@@ -25,6 +25,10 @@ class PublicError(Exception):
     def lines(self) -> list[str]:
         return [f"{self}; retry later" if self.retry_later else str(self)]
 
+    def field_problems(self) -> list[dict[str, str]]:
+        """The lines that are about one request field, with its name (a 422's ``fields``)."""
+        return []
+
     def headers(self, retry_after_s: int) -> dict[str, str] | None:
         """Retry-After for a retry-later error: the suggested wait rounded up, never under
         the service's ``retry_after_s``."""

@@ -13,6 +13,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
+    ConfigDict,
     Field,
     ValidationError,
     ValidationInfo,
@@ -33,6 +34,7 @@ from opaline.model.material import MdfName as MdfName
 # Re-exported: the CLI and the API read a field's range next to the models.
 from opaline.model.messages import field_range as field_range
 from opaline.model.scene_fields import SceneFields
+from opaline.model.schema_groups import add_groups
 from opaline.model.tiers import AntiAliasName, QualityName
 
 ImageFormat = Literal["png", "png16", "npy", "webp", "webp-lossless", "avif", "jpeg"]
@@ -149,6 +151,7 @@ class RenderFields(MaterialFields, SceneFields):  # type: ignore[misc,valid-type
 class RenderRequest(RenderFields):
     """A render request: a preset and any fields that override its defaults."""
 
+    model_config = ConfigDict(json_schema_extra=add_groups)
     preset: str = Field("sphere", description="Scene preset name (GET /v1/presets lists them).")
 
 

@@ -19,12 +19,17 @@ class LimitError(PublicError, ValueError):
 
     status, reason = 422, "limit"
 
-    def __init__(self, problems: list[str]) -> None:
+    def __init__(self, problems: list[str], fields: list[str | None] | None = None) -> None:
         super().__init__("; ".join(problems))
         self.problems = problems
+        self.fields = fields or [None] * len(problems)  # the field each problem is about
 
     def lines(self) -> list[str]:
         return self.problems
+
+    def field_problems(self) -> list[dict[str, str]]:
+        return [{"field": name, "message": line}
+                for name, line in zip(self.fields, self.problems, strict=True) if name is not None]
 
 
 @dataclass(frozen=True)
@@ -43,12 +48,11 @@ def check_limits(job: Job, limits: Limits) -> None:
     """Refuse what the output cannot hold, then what is too large, then what costs too much."""
     if job.transparent and job.format not in HAS_ALPHA:
         raise LimitError([f"format={job.format} has no alpha channel: transparent=true needs "
-                          "png, png16, webp, webp-lossless or avif"])
-    problems = [over_limit(name, value, limit)
-                for name, value, limit in (("width", job.width, limits.max_width),
-                                           ("height", job.height, limits.max_height))
-                if limit is not None and value > limit]
-    if problems:
-        raise LimitError(problems)
+                          "png, png16, webp, webp-lossless or avif"], ["format"])
+    over = [(name, value, limit) for name, value, limit in (("width", job.width, limits.max_width),
+                                                           ("height", job.height, limits.max_height))
+            if limit is not None and value > limit]
+    if over:
+        raise LimitError([over_limit(*args) for args in over], [name for name, _, _ in over])
     if limits.cost_budget is not None:
         check_cost(job, limits.cost_budget)

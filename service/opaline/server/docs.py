@@ -25,7 +25,7 @@ from starlette.datastructures import MutableHeaders
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 ASSETS = "/docs-assets"
-# The page (app.js) sets no inline script or style; images are blob: URLs of fetched answers
+# The page (its ES modules) sets no inline script or style; images are blob: URLs of fetched answers
 # (which a script may read back: connect-src blob:).
 PAGE_CSP = ("default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' blob: data:; "
             "connect-src 'self' blob:; object-src 'none'; base-uri 'none'; form-action 'self'; "

@@ -57,11 +57,21 @@ class Busy(PublicError):
 # The error bodies as the OpenAPI document shows them
 
 
+class FieldProblem(BaseModel):
+    """One line of a 422's detail with the request field it is about."""
+
+    field: str = Field(description="The request field (top level: albedo for albedo.0).")
+    message: str = Field(description="Its line of detail, as written there.")
+
+
 class Problem(BaseModel):
     """Every error answer, whatever its status."""
 
     error: str = Field(description="Why, in one word: " + ", ".join(REJECT_REASONS) + ".")
     detail: list[str] = Field(description="One line per problem: field, value, what is allowed.")
+    fields: list[FieldProblem] = Field(
+        default_factory=list, description="422 only: the problems that are about one request "
+                                          "field, each with its line of detail.")
 
 
 # Reasons of the errors Starlette raises itself (routing, body limit, access control).
@@ -104,11 +114,34 @@ def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> l
     return lines + describe_errors(rest, model)
 
 
+def _field_of(loc: tuple) -> str | None:
+    """The top-level request field of an error location (FastAPI's start with body/query)."""
+    loc = loc[1:] if loc and loc[0] in ("body", "query", "path") else loc
+    return loc[0] if loc and isinstance(loc[0], str) else None
+
+
+def _validation_fields(errors: list[dict[str, Any]], model: type[BaseModel],
+                       lines_of: Any) -> list[dict[str, str]]:
+    """``fields`` of a 422: each error about a field, with the line ``lines_of`` gives it
+    alone (the lines are written one per error, so they are those of ``detail``)."""
+    found = []
+    for err in errors:
+        name = _field_of(tuple(err.get("loc", ())))
+        if name is not None:
+            found.extend({"field": name, "message": line} for line in lines_of([err], model))
+    return found
+
+
 def problem(status: int, reason: str, detail: str | list[str],
-            headers: dict[str, str] | None = None) -> JSONResponse:
-    """The one error body: ``{"error": reason, "detail": [lines]}``."""
+            headers: dict[str, str] | None = None,
+            fields: list[dict[str, str]] | None = None) -> JSONResponse:
+    """The one error body: ``{"error": reason, "detail": [lines]}``; a 422's also has
+    ``fields``, its problems about a request field (``[{"field": name, "message": line}]``)."""
     lines = [detail] if isinstance(detail, str) else detail
-    return JSONResponse({"error": reason, "detail": lines}, status_code=status, headers=headers)
+    body: dict[str, Any] = {"error": reason, "detail": lines}
+    if status == 422:
+        body["fields"] = fields or []
+    return JSONResponse(body, status_code=status, headers=headers)
 
 
 def validation_code(errors: list[Any]) -> str:
@@ -121,21 +154,25 @@ async def on_invalid(request: Request, exc: RequestValidationError) -> JSONRespo
     code = validation_code(list(exc.errors()))
     request.app.state.metrics.reject(code)
     model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
-    return problem(422, code, _validation_lines(list(exc.errors()), model))
+    errors = list(exc.errors())
+    return problem(422, code, _validation_lines(errors, model),
+                   fields=_validation_fields(errors, model, _validation_lines))
 
 
 async def on_public_error(request: Request, exc: PublicError) -> JSONResponse:
     """Any failure of this package, as it says it is answered."""
     settings = request.app.state.settings
     request.app.state.metrics.reject(exc.reason)
-    return problem(exc.status, exc.reason, exc.lines(), exc.headers(settings.retry_after_s))
+    return problem(exc.status, exc.reason, exc.lines(), exc.headers(settings.retry_after_s),
+                   fields=exc.field_problems())
 
 
 async def on_invalid_model(request: Request, exc: ValidationError) -> JSONResponse:
     """A model that a route validated itself (a strictly parsed body)."""
     reason = validation_code(exc.errors())
     request.app.state.metrics.reject(reason)
-    return problem(422, reason, describe_errors(exc))
+    return problem(422, reason, describe_errors(exc),
+                   fields=_validation_fields(exc.errors(), RenderRequest, describe_errors))
 
 
 async def on_http_error(request: Request, exc: HTTPException) -> JSONResponse:

@@ -44,7 +44,7 @@ from opaline.workers.tasks import ImageTask, MdfTask, Task
 def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     size = min(settings.max_width, settings.max_height)
     if params.size > size:
-        raise LimitError([over_limit("size", params.size, size)])
+        raise LimitError([over_limit("size", params.size, size)], ["size"])
     check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
 
 
