@@ -9,7 +9,7 @@ lights; the preset's ambient term stays.
 
 from __future__ import annotations
 
-from opaline.gl.camera import place_key_light
+from opaline.model.camera import place_key_light
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.scene.environments import environment_lights

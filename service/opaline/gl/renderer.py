@@ -24,14 +24,7 @@ from opaline.gl.buffers import (
     read_bytes,
     read_float,
 )
-from opaline.gl.camera import (
-    fit_matrix,
-    model_matrix,
-    view_camera,
-    view_projection,
-)
 from opaline.gl.context import GLContext, create_context
-from opaline.gl.detail import scene_for_size
 from opaline.gl.kept import Kept
 from opaline.gl.lighting import light_uniforms
 from opaline.gl.probes import Probes
@@ -39,6 +32,13 @@ from opaline.gl.resolve import Resolve
 from opaline.gl.shaders import ProgramCache
 from opaline.gl.variants import surface_defines
 from opaline.lru import BudgetLRU
+from opaline.model.camera import (
+    fit_matrix,
+    model_matrix,
+    view_camera,
+    view_projection,
+)
+from opaline.model.detail import scene_for_size
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job
 from opaline.model.spectrum import wavelength_shift
