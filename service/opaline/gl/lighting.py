@@ -9,11 +9,12 @@ lights; the preset's ambient term stays.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from opaline.model.camera import place_key_light
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.scene.environments import environment_lights
-from opaline.settings import setting
 
 # From bench/results/environment_lights.md (256², against K=256): each light costs about
 # as much as the rest of the shading, and ΔE00 mean falls from 2-4 (K=8) through 1-2.3
@@ -25,13 +26,14 @@ def environment_count(job: Job) -> int:
     return job.environment_lights or ENVIRONMENT_LIGHTS[job.quality]
 
 
-def light_uniforms(job: Job, preset: Preset) -> dict[str, list[tuple]]:
+def light_uniforms(job: Job, preset: Preset,
+                   environments_dir: Path | None) -> dict[str, list[tuple]]:
     """``u_light_position`` (xyz and w: 1 point, 0 directional) and ``u_light_irradiance``."""
     if job.environment:
         direction, irradiance = environment_lights(
             job.environment, environment_count(job), job.environment_rotation or 0.0,
             1.0 if job.environment_intensity is None else job.environment_intensity,
-            setting("environments_dir"))
+            environments_dir)
         return {"u_light_position": [(*map(float, d), 0.0) for d in direction],
                 "u_light_irradiance": [tuple(map(float, e)) for e in irradiance]}
     lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,

@@ -143,7 +143,8 @@ def renderer_for(settings: Settings) -> RendererFactory:
     mib = 1024 * 1024
     return RendererFactory(settings.gl_backend, max_programs=settings.worker_programs,
                            scene_bytes=settings.worker_scene_mb * mib,
-                           target_bytes=settings.worker_target_mb * mib)
+                           target_bytes=settings.worker_target_mb * mib,
+                           environments_dir=settings.environments_dir)
 
 
 def document(app: FastAPI, *models: type[BaseModel]) -> None:
