@@ -26,7 +26,7 @@ GLSL_TYPES = {"real": "float", "real2": "vec2", "real3": "vec3"}
 ENTRY = """
 // The exported entry point.
 vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
-    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v));
+    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v, -1.0));
 }
 """
 
