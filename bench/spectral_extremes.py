@@ -39,7 +39,7 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=96)
     args = parser.parse_args()
 
-    from opaline.gl import uniforms
+    from opaline.gl import material_program
     from opaline.gl.renderer import Renderer
     from opaline.model.params import RenderRequest
     from opaline.model.presets import get_preset
@@ -62,7 +62,7 @@ def main() -> None:
              f"| reference ({s}×{w}) vs {2 * s}×{2 * w} |", "|---|---|---|---|---|---|"]
     try:
         for rule, function in (("held (now)", rotation_at), ("extended (before)", extended)):
-            uniforms.rotation_at = function  # what the renderer's uniforms call
+            material_program.rotation_at = function  # what the renderer's uniforms call
             for preset, theta1, theta2 in CASES:
                 lam = sample_wavelengths(400)
                 span = float(np.ptp(function(lam, theta1, theta2)))
@@ -74,7 +74,7 @@ def main() -> None:
                              f"| {spectrum:.4f} | {converged:.4f} |")
                 print(lines[-1], flush=True)
     finally:
-        uniforms.rotation_at = rotation_at
+        material_program.rotation_at = rotation_at
         renderer.release()
     text = "\n".join(lines) + "\n"
     write_atomic(ROOT / "bench" / "results" / "spectral_extremes.md", text.encode())

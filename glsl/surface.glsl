@@ -114,8 +114,10 @@ void main() {
 #endif
     mat3 frame = shading_frame(n, t);
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
-    film_thickness = mix(u_film_thickness_min, u_film_thickness_max,
-                         texture(u_thickness_map, v_uv).r);
+    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+                        texture(u_thickness_map, v_uv).r);
+#else
+    float film_nm = -1.0;  // the material's maximum (thin film), else not read
 #endif
     vec3 v = normalize(u_eye - v_world);
 
@@ -126,7 +128,7 @@ void main() {
         float dist2 = max(dot(to_light, to_light), 1e-8);
         vec3 l = to_light * inversesqrt(dist2);
         float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
-        radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v);
+        radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v, film_nm);
     }
 #ifdef DIFFUSE
     radiance += u_ambient * u_kd * u_albedo;
@@ -135,7 +137,7 @@ void main() {
     // A free, lossless film transmits what it does not reflect: the backdrop seen
     // through both walls, each met at the view's angle to the surface (the back
     // wall's own thickness is not known: this one's is used).
-    vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm());
+    vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm(film_nm));
     radiance += u_backdrop * through * through;
 #endif
 #ifdef DISPLAY

@@ -34,8 +34,9 @@ def backend() -> str:
 @pytest.fixture(scope="session")
 def renderer(backend):
     from opaline.gl.renderer import Renderer
+    from opaline.settings import setting
 
-    r = Renderer(backend)
+    r = Renderer(backend, environments_dir=setting("environments_dir"))
     yield r
     r.release()
 

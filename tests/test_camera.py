@@ -1,11 +1,11 @@
-"""Camera and key-light placement (opaline.gl.camera): the override keeps distance and centre."""
+"""Camera and key-light placement (opaline.model.camera): the override keeps distance and centre."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from opaline.gl.camera import key_light_direction, place_key_light
+from opaline.model.camera import key_light_direction, place_key_light
 from opaline.model.presets import Light
 
 TARGET = (0.5, -0.25, 1.0)

@@ -1,11 +1,11 @@
-"""Thumbnails draw a coarser mesh (opaline.gl.detail), and it does not change how they look."""
+"""Thumbnails draw a coarser mesh (opaline.model.detail), and it does not change how they look."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from opaline.gl import detail
+from opaline.model import detail
 from opaline.model.params import RenderRequest
 from opaline.model.presets import all_presets, build_assets, get_preset
 from opaline.model.request import resolve

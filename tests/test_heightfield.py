@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from opaline.gl import heightfield
-from opaline.gl.detail import scene_for_size
+from opaline.model import detail
+from opaline.model.detail import scene_for_size
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Generator, get_preset
 from opaline.model.request import resolve
@@ -53,11 +54,11 @@ def test_only_wavy_sheets_of_up_to_eight_waves_are_analytic():
 def test_only_gentle_resolved_waves_get_the_quarter_mesh():
     """Steep waves need the mesh's heights and outline, short ones its cells: half only."""
     for name in ("oil-slick", "oil-slick-soft", "oil-film"):
-        assert heightfield.thumbnail_divisor(get_preset(name)) == 4, name
+        assert detail.thumbnail_divisor(get_preset(name)) == 4, name
     steep = with_waves("oil-slick", [[0.08, 0.3, 20.0, 0.0]])  # slope 1.7
     short = with_waves("oil-slick", [[0.001, 0.3, 20.0, 0.0]])  # 3.5 cells of the quarter
     for preset in (steep, short):
-        assert heightfield.thumbnail_divisor(preset) == 2
+        assert detail.thumbnail_divisor(preset) == 2
         assert scene_for_size(preset, 256, 256).geometry.args["resolution"] == 96
 
 
@@ -86,7 +87,7 @@ def test_analytic_slope_on_a_coarse_mesh_matches_vertex_normals_on_a_fine_one(
         kind="wavy", **{**preset.geometry.args, "resolution": 192})})
     for name_ in ("defines", "uniforms"):
         monkeypatch.setattr(heightfield, name_, lambda preset: {})
-    monkeypatch.setattr(heightfield, "thumbnail_divisor", lambda preset: 4)  # same coarsening
+    monkeypatch.setattr(detail, "thumbnail_divisor", lambda preset: 4)  # same coarsening
     reference, interpolated = linear(renderer, fine), linear(renderer, coarse)
     scale = np.percentile(reference[..., :3], 99)
     error = np.abs(analytic - reference)[..., :3].mean() / scale

@@ -11,7 +11,7 @@ import pytest
 from mesh_helpers import FORMATS, broken_files, mesh_bytes, torus_with_uvs
 from opaline.cli import main as cli
 from opaline.gl.buffers import bounding_sphere
-from opaline.gl.camera import fit_matrix, framing_distance
+from opaline.model.camera import fit_matrix, framing_distance
 from opaline.scene import tangents
 from opaline.scene.meshfile import MeshError, parse_mesh
 

@@ -123,7 +123,7 @@ def test_framebuffers_are_reused_per_size(renderer):
     job = job_for("sphere", format="npy", quality="draft")
     for size in (32, 48, 64, 80, 96, 112, 32):
         renderer.render(replace(job, width=size, height=size))
-    assert len(renderer._targets) <= 4
+    assert len(renderer.resources.kept_targets) <= 4
     before = renderer.targets((32, 32))
     assert renderer.targets((32, 32)) is before
 

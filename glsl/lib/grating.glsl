@@ -9,9 +9,6 @@
 #define GRATING_GLSL
 #include "lib/common.glsl"
 #include "lib/material.glsl"
-#ifdef FRESNEL
-#include "lib/fresnel.glsl"
-#endif
 
 // GRATING_ORDERS (1-8) is a compile-time define: the orders are written out below,
 // and with a literal m the Bessel series' divisors are constants.
@@ -56,11 +53,11 @@ float order_lobe(vec3 k, vec3 vl, float cos_max) {
     vec3 h = k / k_len;
     float vh = dot(vl, h);
 #ifdef FRESNEL
-    float f = fresnel_schlick(vh);
+    float f = fresnel_schlick(vh, u_f0);
 #else
     float f = 1.0;
 #endif
-    return f * mdf_ashikhmin(h.xy, h.z) * max(vh, 0.0) / (k2 * cos_max);
+    return f * mdf_ashikhmin(h.xy, h.z, u_ex, u_ey) * max(vh, 0.0) / (k2 * cos_max);
 }
 
 #if WAVELENGTHS > 0

@@ -6,14 +6,37 @@
 #include "lib/common.glsl"
 #include "lib/rotation.glsl"
 
+// The material's scalar parameters are read here, once for the library: the MDFs
+// and Schlick's term (lib/mdf_*.glsl, lib/fresnel.glsl) take theirs as arguments.
 #if defined(MDF_ASHIKHMIN)
 #include "lib/mdf_ashikhmin.glsl"
-#define mdf mdf_ashikhmin
+uniform float u_ex;
+uniform float u_ey;
+
+float mdf(real2 h, float hz) {
+    return mdf_ashikhmin(h, hz, u_ex, u_ey);
+}
 #elif defined(MDF_MULTIPEAK)
 #include "lib/mdf_multipeak.glsl"
-#define mdf mdf_multipeak
+uniform real u_mu_f;
+uniform real u_alpha;
+uniform real u_beta;
+#ifdef AA_ANALYTIC
+uniform float u_aa_scale;
+#define MDF_AA_SCALE u_aa_scale
+#else
+#define MDF_AA_SCALE 1.0  // not read: no filter is compiled in
+#endif
+
+float mdf(real2 h, float hz) {
+    return mdf_multipeak(h, hz, u_mu_f, u_alpha, u_beta, MDF_AA_SCALE);
+}
 #else
 #error "define MDF_ASHIKHMIN or MDF_MULTIPEAK"
+#endif
+#ifdef FRESNEL
+#include "lib/fresnel.glsl"
+uniform float u_f0;
 #endif
 
 #if WAVELENGTHS > 0

@@ -5,9 +5,6 @@
 #define MDF_ASHIKHMIN_GLSL
 #include "lib/common.glsl"
 
-uniform float u_ex;
-uniform float u_ey;
-
 // -log1p(-s2)/s2: 1 at the pole, growing toward the rim. GLSL has no log1p,
 // and fp32 log(u) near u = 1 is only accurate in absolute terms, which at
 // exponents of 1e5-1e6 (lobes at s2 ~ 1e-5) costs percents. Near the pole the
@@ -29,12 +26,12 @@ float log1p_ratio(float s2) {
     return log(u) / (u - 1.0);
 }
 
-float mdf_ashikhmin(real2 h, float hz) {
+float mdf_ashikhmin(real2 h, float hz, float ex, float ey) {
     float hx2 = float(h.x * h.x);
     float hy2 = float(h.y * h.y);
     float s2 = min(hx2 + hy2, 1.0);
-    float log_term = -0.5 * (u_ex * hx2 + u_ey * hy2) * log1p_ratio(s2);
-    float norm = sqrt((u_ex + 1.0) * (u_ey + 1.0)) / TWO_PI;
+    float log_term = -0.5 * (ex * hx2 + ey * hy2) * log1p_ratio(s2);
+    float norm = sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI;
     return hz > 0.0 ? norm * exp(log_term) : 0.0;
 }
 

@@ -6,31 +6,25 @@
 // cos(x0)·sinc(a/2)·sinc(b/2), a product of two sincs. (One sinc of fwidth =
 // |a| + |b| blurred diagonal bands: docs/accuracy.md.) N supersamples on a
 // well-stratified pattern each own a cell about 1/√N of the pixel's width, so the
-// box is scaled by u_aa_scale = 1/√N; the cells tile the pixel, so the filtered
+// box is scaled by aa_scale = 1/√N; the cells tile the pixel, so the filtered
 // samples average to the pixel's box.
 #ifndef MDF_MULTIPEAK_GLSL
 #define MDF_MULTIPEAK_GLSL
 #include "lib/common.glsl"
-
-uniform real u_mu_f;
-uniform real u_alpha;
-uniform real u_beta;
-#ifdef AA_ANALYTIC
-uniform float u_aa_scale;
-#endif
 
 float sinc_half(float footprint) {
     float half_width = 0.5 * footprint;
     return half_width > 1e-4 ? sin(half_width) / half_width : 1.0 - half_width * half_width / 6.0;
 }
 
-float mdf_multipeak(real2 h, float hz) {
-    real r = sqrt(u_alpha * h.x * h.x + u_beta * h.y * h.y);
-    real cycles = u_mu_f * r;
+// aa_scale: the sample's share of the pixel's width (read only under AA_ANALYTIC).
+float mdf_multipeak(real2 h, float hz, real mu_f, real alpha, real beta, float aa_scale) {
+    real r = sqrt(alpha * h.x * h.x + beta * h.y * h.y);
+    real cycles = mu_f * r;
     float phase = TWO_PI * float(cycles - floor(cycles));
     float band = cos(phase);
 #ifdef AA_ANALYTIC
-    float box = TWO_PI * u_aa_scale;
+    float box = TWO_PI * aa_scale;
     band *= sinc_half(box * abs(dFdx(float(cycles)))) * sinc_half(box * abs(dFdy(float(cycles))));
 #endif
     return 0.5 * max(hz, 0.0) * (band + 1.0);

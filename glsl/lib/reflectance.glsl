@@ -6,9 +6,6 @@
 #include "lib/common.glsl"
 #include "lib/frame.glsl"
 #include "lib/material.glsl"
-#ifdef FRESNEL
-#include "lib/fresnel.glsl"
-#endif
 #if defined(IRIDESCENCE_THIN_FILM)
 #include "lib/thin_film.glsl"
 #elif defined(IRIDESCENCE_GRATING)
@@ -21,7 +18,9 @@ uniform float u_kd;
 uniform vec3 u_albedo;
 #endif
 
-vec3 specular(realmat3 frame, vec3 l, vec3 v) {
+// film_nm: the thin film's thickness here (negative: the material's maximum, as KHR's
+// without a thickness texture); not read by the other sources.
+vec3 specular(realmat3 frame, vec3 l, vec3 v, float film_nm) {
 #ifdef IRIDESCENCE_GRATING
     return u_ks * grating_specular(frame, l, v);
 #else
@@ -36,14 +35,14 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v) {
     float vh = float(dot(real3(v), h));
 #ifdef IRIDESCENCE_THIN_FILM
     // The unrotated lobe, coloured by the film instead of by rotation (Fresnel off).
-    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z)) * film_rgb(vh, film_thickness_nm());
+    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), u_ex, u_ey) * film_rgb(vh, film_thickness_nm(film_nm));
 #else
     vec3 d = mdf_color(hl.xy, float(hl.z));
 #endif
     float nl = float(dot(frame[2], real3(l)));
     float nv = float(dot(frame[2], real3(v)));
 #ifdef FRESNEL
-    float f = fresnel_schlick(vh);
+    float f = fresnel_schlick(vh, u_f0);
 #else
     float f = 1.0;
 #endif
@@ -52,8 +51,8 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v) {
 #endif
 }
 
-vec3 reflected_radiance(realmat3 frame, vec3 l, vec3 v) {
-    vec3 f = specular(frame, l, v);
+vec3 reflected_radiance(realmat3 frame, vec3 l, vec3 v, float film_nm) {
+    vec3 f = specular(frame, l, v, film_nm);
 #ifdef DIFFUSE
     f += u_kd * u_albedo / PI;
 #endif

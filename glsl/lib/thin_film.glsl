@@ -15,12 +15,10 @@ uniform float u_substrate_ior;
 uniform float u_film_thickness_min;
 uniform float u_film_thickness_max;
 
-// This fragment's thickness in nm, set by the surface from its thickness field;
-// negative (the probe, a surface without a field) means the maximum, as in KHR.
-float film_thickness = -1.0;
-
-float film_thickness_nm() {
-    return film_thickness >= 0.0 ? film_thickness : u_film_thickness_max;
+// A fragment's thickness in nm from what its caller knows: its thickness field's value,
+// or negative (the probe, a surface without a field) for the maximum, as in KHR.
+float film_thickness_nm(float film_nm) {
+    return film_nm >= 0.0 ? film_nm : u_film_thickness_max;
 }
 
 float film_ratio(float num, float den) {

@@ -44,7 +44,10 @@ class GLProcesses:
     def __init__(self, jobs: int, backend: str | None) -> None:
         import os
 
-        self.pool = WorkerPool(RendererFactory(backend), workers=jobs, queue_size=1 << 20,
+        from opaline.settings import setting
+
+        factory = RendererFactory(backend, environments_dir=setting("environments_dir"))
+        self.pool = WorkerPool(factory, workers=jobs, queue_size=1 << 20,
                                deadline_s=NO_DEADLINE_S, render_timeout_s=RENDER_LIMIT_S,
                                lp_threads=max(1, (os.cpu_count() or 1) // jobs), calibrate=False)
         self.pool.start()

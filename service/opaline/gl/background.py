@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from collections.abc import Callable
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -18,22 +19,23 @@ from opaline.gl import uniforms
 from opaline.gl.shaders import ProgramCache
 from opaline.model.request import Job
 from opaline.scene.environments import resolve_map
-from opaline.settings import setting
 
 KEPT = 4
 ENVIRONMENT_UNIT = 2  # 0: the accumulate pass's source, 1: the normal map
 
 
 class Backgrounds:
-    def __init__(self, ctx: moderngl.Context, empty_vao: Callable[[moderngl.Program], None]):
+    def __init__(self, ctx: moderngl.Context, fullscreen: Callable[[moderngl.Program], None],
+                 environments_dir: Path | None):
         self.ctx = ctx
-        self.fullscreen = empty_vao
+        self.fullscreen = fullscreen
+        self.environments_dir = environments_dir
         self._maps: OrderedDict[str, moderngl.Texture] = OrderedDict()
 
     def texture(self, name: str) -> moderngl.Texture:
         found = self._maps.get(name)
         if found is None:
-            radiance = resolve_map(name, setting("environments_dir"))
+            radiance = resolve_map(name, self.environments_dir)
             height, width = radiance.shape[:2]
             # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
             data = np.ascontiguousarray(radiance[::-1], dtype="f4")

@@ -17,7 +17,7 @@ import json
 import re
 
 from opaline import __version__
-from opaline.gl import uniforms
+from opaline.gl import material_program
 from opaline.gl.shaders import expand
 from opaline.model.params import Material
 
@@ -26,7 +26,7 @@ GLSL_TYPES = {"real": "float", "real2": "vec2", "real3": "vec3"}
 ENTRY = """
 // The exported entry point.
 vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
-    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v));
+    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v, -1.0));
 }
 """
 
@@ -60,8 +60,8 @@ def _constant(match: re.Match[str], values: dict[str, object]) -> str:
 
 def export_glsl(material: Material, wavelengths: int = 0) -> str:
     """The GLSL source of ``opaline_radiance`` for this material (aa none: no pixel footprint)."""
-    defines = uniforms.material_defines(material, wavelengths)
-    values = uniforms.material_uniforms(material, wavelengths)
+    defines = material_program.material_defines(material, wavelengths)
+    values = material_program.material_uniforms(material, wavelengths)
     values["u_aa_scale"] = 1.0
     lines = [
         f"// Opaline {__version__}: the multi-peak anisotropic microfacet model (Kang, Lee,",

@@ -8,20 +8,22 @@ An environment replaces the preset's lights; the preset's ambient term stays.
 
 from __future__ import annotations
 
-from opaline.gl.camera import place_key_light
+from pathlib import Path
+
+from opaline.model.camera import place_key_light
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.scene.environments import environment_lights
-from opaline.settings import setting
 
 
-def light_uniforms(job: Job, preset: Preset) -> dict[str, list[tuple]]:
+def light_uniforms(job: Job, preset: Preset,
+                   environments_dir: Path | None) -> dict[str, list[tuple]]:
     """``u_light_position`` (xyz and w: 1 point, 0 directional) and ``u_light_irradiance``."""
     if job.environment:
         direction, irradiance = environment_lights(
             job.environment, job.environment_count, job.environment_rotation or 0.0,
             1.0 if job.environment_intensity is None else job.environment_intensity,
-            setting("environments_dir"))
+            environments_dir)
         return {"u_light_position": [(*map(float, d), 0.0) for d in direction],
                 "u_light_irradiance": [tuple(map(float, e)) for e in irradiance]}
     lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,

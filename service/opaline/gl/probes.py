@@ -11,33 +11,35 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from opaline.gl import uniforms
+from opaline.gl import material_program, uniforms
+from opaline.gl.buffers import read_float
+from opaline.gl.resources import Resources
 from opaline.model.params import Material
 
 
 class Probes:
-    """The plot and the probe, as methods of ``Renderer``.
+    """The plot and the probe, drawn with the renderer's resources (the renderer hands
+    its callers these methods)."""
 
-    They need what the renderer owns: ``gl``, ``ctx``, ``programs``, ``targets()``,
-    ``fullscreen()`` and ``read()``; a mixin keeps them on the renderer (where the
-    tests, the CLI and the service call them) without this module importing it.
-    """
+    def __init__(self, resources: Resources) -> None:
+        self.resources = resources
 
     def mdf_plot(
         self, material: Material, size: int, wavelengths: int = 0, aa: str = "none"
     ) -> np.ndarray:
         """The MDF over the projected half-vector disc, (size, size, 3) linear float32."""
-        self.gl.make_current()
-        defines = uniforms.mdf_defines(material, wavelengths, aa)
-        defines["PRECISE_PHASE"] = self.gl.has_fp64
-        program = self.programs.get("mdf_plot.glsl", defines)
-        targets = self.targets((size, size))
-        uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
+        res = self.resources
+        res.gl.make_current()
+        defines = material_program.plot_defines(material, wavelengths, aa)
+        defines["PRECISE_PHASE"] = res.gl.has_fp64
+        program = res.programs.get("mdf_plot.glsl", defines)
+        targets = res.targets((size, size))
+        uniforms.apply(program, material_program.material_uniforms(material, wavelengths))
         uniforms.apply(program, {"u_size": size, "u_aa_scale": 1.0})
         targets.display_fbo.use()
-        self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-        self.fullscreen(program)
-        return self.read(targets.display_fbo, (size, size))[..., :3]
+        res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+        res.fullscreen(program)
+        return read_float(targets.display_fbo, (size, size))[..., :3]
 
     def probe(
         self,
@@ -49,14 +51,15 @@ class Probes:
         wavelengths: int = 0,
     ) -> np.ndarray:
         """Reflected radiance for each (n, t, l, v) case through the surface shading code."""
-        self.gl.make_current()
+        res = self.resources
+        res.gl.make_current()
         count = len(n)
         width = min(count, 256)
         height = -(-count // width)
         # aa stays "none" (AA_ANALYTIC false, so not compiled in): a probe has no pixel footprint.
-        defines = uniforms.material_defines(material, wavelengths)
-        defines["PRECISE_PHASE"] = self.gl.has_fp64
-        program = self.programs.get("brdf_probe.glsl", defines)
+        defines = material_program.material_defines(material, wavelengths)
+        defines["PRECISE_PHASE"] = res.gl.has_fp64
+        program = res.programs.get("brdf_probe.glsl", defines)
         textures = []
         try:
             for unit, (name, data) in enumerate(
@@ -64,17 +67,17 @@ class Probes:
             ):
                 grid = np.zeros((height * width, 4), dtype="f4")
                 grid[:count, :3] = data
-                tex = self.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
+                tex = res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
                 textures.append(tex)
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.use(location=unit)
                 program[name].value = unit
-            uniforms.apply(program, uniforms.material_uniforms(material, wavelengths))
-            targets = self.targets((width, height))
+            uniforms.apply(program, material_program.material_uniforms(material, wavelengths))
+            targets = res.targets((width, height))
             targets.display_fbo.use()
-            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-            self.fullscreen(program)
-            image = self.read(targets.display_fbo, (width, height))
+            res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+            res.fullscreen(program)
+            image = read_float(targets.display_fbo, (width, height))
         finally:
             for tex in textures:
                 tex.release()

@@ -23,7 +23,7 @@ from fastapi.responses import FileResponse, RedirectResponse, Response
 from pydantic import BaseModel
 
 from opaline import __version__
-from opaline.gl.camera import key_light_direction
+from opaline.model.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
 from opaline.model.request import resolve
@@ -152,7 +152,8 @@ def renderer_for(settings: Settings) -> RendererFactory:
     mib = 1024 * 1024
     return RendererFactory(settings.gl_backend, max_programs=settings.worker_programs,
                            scene_bytes=settings.worker_scene_mb * mib,
-                           target_bytes=settings.worker_target_mb * mib)
+                           target_bytes=settings.worker_target_mb * mib,
+                           environments_dir=settings.environments_dir)
 
 
 def document(app: FastAPI, *models: type[BaseModel]) -> None:

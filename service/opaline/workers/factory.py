@@ -4,6 +4,7 @@ imports moderngl or touches GL itself."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 
@@ -13,10 +14,11 @@ class RendererFactory:
     max_programs: int = 64
     scene_bytes: int = 128 * 1024 * 1024
     target_bytes: int = 256 * 1024 * 1024
+    environments_dir: Path | None = None  # the user's environment maps (settings)
 
     def __call__(self) -> Any:
         from opaline.gl.renderer import RenderBudgets, Renderer
 
         budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
                                 target_bytes=self.target_bytes)
-        return Renderer(self.backend, budgets=budgets)
+        return Renderer(self.backend, budgets=budgets, environments_dir=self.environments_dir)

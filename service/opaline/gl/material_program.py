@@ -1,0 +1,156 @@
+"""A material, with the job's settings and the scene, as what a program compiles and is
+fed: its feature defines (one per feature in use, so features that are off are not
+compiled in) and its uniform values.
+
+Two sources speak about the same defines: the paper's model (its MDF, Fresnel and
+analytic filter) and a physical iridescence source (thin film, grating; docs/physics.md).
+Where both do, the physical source wins, for the reasons below; every other define has
+exactly one source (the scene's: normal map, tangents, lights, waves, thickness map,
+transmission).
+
+    define         paper's rule                physical source (wins)   why it wins
+    MDF_MULTIPEAK  mdf == "multipeak"          False                    film and grating colour the A-S lobe
+    MDF_ASHIKHMIN  mdf == "ashikhmin"          True                     (their own lobe, not the paper's peaks)
+    AA_ANALYTIC    multi-peak and aa=analytic  False                    no multi-peak phase to filter
+    FRESNEL        f0 < 1                      film: False;             the film's Airy reflectance is its
+                                               grating: f0 < 1          Fresnel term; a grating keeps Schlick's
+                                                                        (its coating's reflectance)
+
+The MDF plot compiles the paper's MDF rule alone (``plot_defines``): it draws the
+material's ``mdf`` over the half-vector disc, whatever its iridescence.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from opaline.gl import heightfield
+from opaline.model import grating, visible
+from opaline.model.params import Material
+from opaline.model.presets import Preset
+from opaline.model.request import Job
+from opaline.model.spectrum import CENTRE, rgb_weights, rotation_at, sample_wavelengths
+
+Defines = dict[str, int | bool]
+
+
+def is_physical(material: Material) -> bool:
+    return material.iridescence != "rotation"
+
+
+def plot_defines(material: Material, wavelengths: int = 0, aa: str = "none") -> Defines:
+    """The paper's MDF features alone: what the MDF plot compiles (it has no reflectance)."""
+    multipeak = material.mdf == "multipeak"
+    return {
+        "MDF_MULTIPEAK": multipeak,
+        "MDF_ASHIKHMIN": not multipeak,
+        "WAVELENGTHS": wavelengths if wavelengths > 0 else False,
+        "AA_ANALYTIC": multipeak and aa == "analytic",
+    }
+
+
+def _physical_defines(material: Material) -> Defines:
+    """What a physical source decides, the contested defines included (the table above)."""
+    thin_film = material.iridescence == "thin-film"
+    return {
+        "IRIDESCENCE_THIN_FILM": thin_film,
+        "IRIDESCENCE_GRATING": not thin_film,
+        "MDF_ASHIKHMIN": True,
+        "MDF_MULTIPEAK": False,
+        "AA_ANALYTIC": False,
+        "FRESNEL": not thin_film and material.f0 < 1.0,
+        # A define so the order and Bessel loops unroll (glsl/lib/grating.glsl).
+        "GRATING_ORDERS": False if thin_film else material.grating_orders,
+    }
+
+
+def material_defines(material: Material, wavelengths: int = 0, aa: str = "none") -> Defines:
+    """Only the features this material uses (docs/design.md §4.3)."""
+    defines = {
+        **plot_defines(material, wavelengths, aa),
+        "DIFFUSE": material.kd > 0.0 and max(material.albedo) > 0.0,
+        "FRESNEL": material.f0 < 1.0,
+    }
+    if is_physical(material):
+        defines.update(_physical_defines(material))  # applied last: the physical source wins
+    return defines
+
+
+def uses_thickness_map(material: Material, preset: Preset) -> bool:
+    return material.iridescence == "thin-film" and preset.thickness_map is not None
+
+
+def uses_transmission(material: Material, preset: Preset) -> bool:
+    return material.iridescence == "thin-film" and preset.transmission
+
+
+def surface_defines(job: Job, preset: Preset) -> Defines:
+    """The surface program's defines: the material's, then the scene's (no key in common)."""
+    defines = material_defines(job.material, job.wavelengths, job.aa)
+    defines["NORMAL_MAP"] = preset.normal_map is not None
+    defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
+    defines["LIGHT_COUNT"] = len(preset.lights)
+    defines.update(heightfield.defines(preset))
+    if uses_thickness_map(job.material, preset):
+        defines["THICKNESS_MAP"] = True
+    if uses_transmission(job.material, preset):
+        defines["TRANSMISSION"] = True
+    return defines
+
+
+def _cos_sin(theta: np.ndarray) -> list[tuple[float, float]]:
+    return [(math.cos(a), math.sin(a)) for a in np.atleast_1d(theta)]
+
+
+def material_uniforms(material: Material, wavelengths: int = 0,
+                      shift: float = CENTRE) -> dict[str, object]:
+    """Every uniform the material's programs may read (a variant ignores those it lacks)."""
+    values: dict[str, object] = {
+        "u_ex": material.ex,
+        "u_ey": material.ey,
+        "u_mu_f": material.mu_f,
+        "u_alpha": material.alpha,
+        "u_beta": material.beta,
+        "u_ks": material.ks,
+        "u_kd": material.kd,
+        "u_albedo": tuple(material.albedo),
+        "u_f0": material.f0,
+    }
+    if wavelengths > 0:
+        values.update(spectral_uniforms(material, wavelengths, shift))
+    else:
+        values["u_rotation"] = _cos_sin(np.array([0.0, material.theta1, material.theta2]))
+    if is_physical(material):
+        values.update(_physical_uniforms(material, wavelengths))
+    return values
+
+
+def spectral_uniforms(material: Material, wavelengths: int, shift: float) -> dict[str, object]:
+    """Rotations and weights of ``wavelengths`` wavelengths at ``shift`` through their bins
+    (spectrum.wavelength_shift): set again before each supersample."""
+    theta = rotation_at(sample_wavelengths(wavelengths, shift), material.theta1, material.theta2)
+    return {"u_spectral_rotation": _cos_sin(theta),
+            "u_spectral_weight": [tuple(w) for w in rgb_weights(wavelengths, shift)]}
+
+
+def _physical_uniforms(material: Material, wavelengths: int) -> dict[str, object]:
+    values: dict[str, object] = {
+        "u_film_ior": material.film_ior,
+        "u_substrate_ior": material.substrate_ior,
+        "u_film_thickness_min": material.film_thickness_min,
+        "u_film_thickness_max": material.film_thickness_max,
+        "u_grating_pitch_nm": 1000.0 * material.grating_pitch,
+        "u_grating_depth_nm": material.grating_depth,
+    }
+    if wavelengths > 0:
+        values["u_wavelength_nm"] = [float(x) for x in sample_wavelengths(wavelengths)]
+    else:
+        gaussians = visible.sensitivity_gaussians()
+        values["u_film_sens_weight"] = [tuple(g) for g in gaussians[..., 0]]
+        values["u_film_sens_centre"] = [tuple(g) for g in gaussians[..., 1]]
+        values["u_film_sens_sigma"] = [tuple(g) for g in gaussians[..., 2]]
+        values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
+        values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
+    return values
