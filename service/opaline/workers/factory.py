@@ -15,7 +15,8 @@ class RendererFactory:
     target_bytes: int = 256 * 1024 * 1024
 
     def __call__(self) -> Any:
-        from opaline.gl.renderer import RenderBudgets, Renderer
+        from opaline.gl.buffers import RenderBudgets
+        from opaline.gl.renderer import Renderer
 
         budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
                                 target_bytes=self.target_bytes)
