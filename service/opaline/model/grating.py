@@ -80,7 +80,8 @@ def order_lobe(
     d = mdf_ashikhmin(kt / k_len, kb / k_len, kn / k_len, material.ex, material.ey)
     vh = (vt * kt + vb * kb + vn * kn) / k_len
     f = fresnel_schlick(material.f0, vh)
-    lobe: FloatArray = f * d * np.maximum(vh, 0.0) / (k2 * np.maximum(np.maximum(ln, vn), EPS_DENOM))
+    lobe: FloatArray = (f * d * np.maximum(vh, 0.0)
+                        / (k2 * np.maximum(np.maximum(ln, vn), EPS_DENOM)))
     return lobe
 
 

@@ -133,7 +133,12 @@ def shading_frame(n: FloatArray, t: FloatArray) -> Frame:
 
 
 def specular_rgb(
-    material: Material, n: FloatArray, t: FloatArray, l: FloatArray, v: FloatArray, wavelengths: int = 0
+    material: Material,
+    n: FloatArray,
+    t: FloatArray,
+    l: FloatArray,
+    v: FloatArray,
+    wavelengths: int = 0,
 ) -> FloatArray:
     """``specular`` in the shading frame of ``n`` and ``t``."""
     return specular(material, shading_frame(n, t), l, v, wavelengths)
@@ -167,7 +172,12 @@ def specular(
 
 
 def reflected_radiance(
-    material: Material, n: FloatArray, t: FloatArray, l: FloatArray, v: FloatArray, wavelengths: int = 0
+    material: Material,
+    n: FloatArray,
+    t: FloatArray,
+    l: FloatArray,
+    v: FloatArray,
+    wavelengths: int = 0,
 ) -> FloatArray:
     """f·max(n·l, 0) for a light of unit irradiance, per channel (linear RGB)."""
     frame = shading_frame(n, t)

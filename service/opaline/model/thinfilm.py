@@ -87,7 +87,9 @@ def film_rgb_spectral(
     return rgb
 
 
-def film_rgb_fast(cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float) -> FloatArray:
+def film_rgb_fast(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float
+) -> FloatArray:
     """Belcour & Barla 2017's evaluation: R(φ) as a Fourier series in φ, each term
     integrated against the colour weights in closed form (``visible.sensitivity``).
 

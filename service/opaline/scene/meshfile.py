@@ -182,7 +182,8 @@ def load_mesh_file(path: str | Path, field: str = "auto",
 
 
 def mesh_file(path: str, digest: str = "", tangent_field: str = "auto",
-              tangent_axis: Sequence[float] = (0.0, 1.0, 0.0), max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
+              tangent_axis: Sequence[float] = (0.0, 1.0, 0.0),
+              max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
     """The geometry generator ``file``: ``digest`` is unused here but names the content in
     the preset's scene key, so a changed file never draws from a stale GPU copy."""
     return load_mesh_file(path, tangent_field, tuple(tangent_axis), max_triangles)[0]
