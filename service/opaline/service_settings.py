@@ -13,7 +13,13 @@ from pathlib import Path
 from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-from opaline.setting_defaults import DEFAULTS, MAX_PIXELS, BackendName
+from opaline.setting_defaults import (
+    DEFAULT_COST_BUDGET,
+    DEFAULT_ENVIRONMENTS_DIR,
+    DEFAULT_MESH_MAX_TRIANGLES,
+    MAX_PIXELS,
+    BackendName,
+)
 
 
 class Settings(BaseSettings):
@@ -70,7 +76,7 @@ class Settings(BaseSettings):
     max_width: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image width.")
     max_height: int = Field(MAX_PIXELS, ge=16, le=MAX_PIXELS, description="Largest image height.")
     cost_budget: int = Field(
-        DEFAULTS["cost_budget"], ge=1,
+        DEFAULT_COST_BUDGET, ge=1,
         description="Largest width×height×samples×max(wavelengths, 3) a request may cost.")
     max_connections: int = Field(
         1024, ge=1, description="Open connections the service accepts before answering 503.")
@@ -100,7 +106,7 @@ class Settings(BaseSettings):
     mesh_max_bytes: int = Field(
         64 * 1024 * 1024, ge=1024, description="Largest mesh file POST /v1/meshes accepts (413).")
     mesh_max_triangles: int = Field(
-        DEFAULTS["mesh_max_triangles"], ge=1, le=50_000_000,
+        DEFAULT_MESH_MAX_TRIANGLES, ge=1, le=50_000_000,
         description="Most triangles a mesh may have (422).")
     mesh_store_bytes: int = Field(
         1024 * 1024 * 1024, ge=1024,
@@ -110,7 +116,7 @@ class Settings(BaseSettings):
     meshes_dir: Path | None = Field(
         None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
     environments_dir: Path | None = Field(
-        DEFAULTS["environments_dir"],
+        DEFAULT_ENVIRONMENTS_DIR,
         description="A folder of HDR environments (.hdr, .exr) requests may name.")
     warmup: bool = Field(
         True, description="Render a tiny image on each worker at start-up, so the first "

@@ -14,10 +14,13 @@ DEFAULT_COST_BUDGET = 2048 * 2048 * 64 * 3
 
 MAX_PIXELS = 2048  # params.Pixels' upper bound: settings may lower it, never raise it
 
+DEFAULT_MESH_MAX_TRIANGLES = 2_000_000
+DEFAULT_ENVIRONMENTS_DIR: Path | None = None
+
 # The defaults of the settings a render reads (``opaline.settings.setting``); the settings
-# class takes its defaults for these fields from here.
+# class takes its defaults for these fields from here (each by its own typed name above).
 DEFAULTS: dict[str, int | Path | None] = {
     "cost_budget": DEFAULT_COST_BUDGET,
-    "mesh_max_triangles": 2_000_000,
-    "environments_dir": None,
+    "mesh_max_triangles": DEFAULT_MESH_MAX_TRIANGLES,
+    "environments_dir": DEFAULT_ENVIRONMENTS_DIR,
 }

@@ -29,7 +29,8 @@ from opaline.setting_defaults import BackendName as BackendName
 if TYPE_CHECKING:
     from pydantic import SecretStr
 
-    from opaline.service_settings import Settings
+    # Re-exported (for type checkers: at run time __getattr__ below imports it on first use).
+    from opaline.service_settings import Settings as Settings
 
 ENV_PREFIX = "opaline_"  # pydantic-settings matches variable names case-insensitively
 

@@ -108,5 +108,5 @@ class RemoteRenderer:
                 return min(max(float(retry_after), 0.0), self.max_delay)
             except ValueError:
                 pass  # an HTTP date: fall back to our own backoff
-        base = min(self.backoff * 2**attempt, self.max_delay)
+        base: float = min(self.backoff * 2**attempt, self.max_delay)
         return base * random.uniform(0.5, 1.0)

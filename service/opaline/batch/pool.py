@@ -52,11 +52,11 @@ class GLProcesses:
                                lp_threads=max(1, (os.cpu_count() or 1) // jobs), calibrate=False)
         self.pool.start()
 
-    def submit(self, task: Task) -> Future:
-        outcome: Future = Future()
+    def submit(self, task: Task) -> Future[Outcome]:
         assert task.prepared is not None and task.key is not None  # only planned tasks run
+        outcome: Future[Outcome] = Future()
         try:
-            job = self.pool.submit(task.key, ImageTask(task.prepared))
+            job = self.pool.submit(task.key, ImageTask(task.prepared))  # type: ignore[arg-type]
         except Exception as exc:  # no worker has a context: the item fails with the reason
             outcome.set_result((None, 0.0, f"{type(exc).__name__}: {exc}"))
             return outcome
@@ -72,7 +72,7 @@ class GLProcesses:
         self.pool.stop(timeout=5.0)
 
 
-def _settle(job: Job, outcome: Future, done: Future) -> None:
+def _settle(job: Job, outcome: Future[Outcome], done: Future[bytes]) -> None:
     exc = done.exception()
     if exc is None:
         outcome.set_result((done.result(), job.seconds, None))
@@ -91,7 +91,8 @@ class HttpThreads:
         self.remote = RemoteRenderer(server, jobs=jobs, retries=retries)
         self.executor = ThreadPoolExecutor(jobs, thread_name_prefix="opaline-http")
 
-    def submit(self, task: Task) -> Future:
+    def submit(self, task: Task) -> Future[Outcome]:
+        assert task.item.request is not None  # planned: a pending task's item has a request
         return self.executor.submit(_render_remote, self.remote, task.item.request)
 
     def close(self) -> None:

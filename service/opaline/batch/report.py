@@ -43,7 +43,8 @@ def junit_xml(summary: dict[str, Any]) -> bytes:
             ElementTree.SubElement(case, "skipped", {"message": "interrupted"})
         elif item["output"]:
             ElementTree.SubElement(case, "system-out").text = f"{item['status']}: {item['output']}"
-    return ElementTree.tostring(root, encoding="utf-8", xml_declaration=True) + b"\n"
+    document: bytes = ElementTree.tostring(root, encoding="utf-8", xml_declaration=True)
+    return document + b"\n"
 
 
 def _escape(text: str, prop: bool = False) -> str:

@@ -25,7 +25,7 @@ from typing import Any
 
 from opaline import __version__
 from opaline.batch.plan import Task, plan, prune, remove_temporaries, write_result
-from opaline.batch.pool import start_pool
+from opaline.batch.pool import Outcome, start_pool
 from opaline.batch.progress import PlainProgress, make_progress
 from opaline.batch.shard import select
 from opaline.batch.sheet import write_contact_sheet
@@ -110,7 +110,7 @@ def render_all(tasks: list[Task], options: Options, progress: PlainProgress) -> 
     if not queue:
         return  # nothing to render: no GL context, no worker process
     pool = start_pool(options.jobs, options.backend, options.server, options.retries)
-    pending: dict[Future, Task] = {}
+    pending: dict[Future[Outcome], Task] = {}
     try:
         while queue or pending:
             while queue and len(pending) < 2 * options.jobs:
@@ -127,7 +127,7 @@ def render_all(tasks: list[Task], options: Options, progress: PlainProgress) -> 
     pool.close()
 
 
-def finish(task: Task, future: Future) -> None:
+def finish(task: Task, future: Future[Outcome]) -> None:
     try:
         data, task.seconds, error = future.result()
     except Exception as exc:  # a worker process died (BrokenProcessPool) or similar
@@ -162,7 +162,7 @@ def write_summary(tasks: list[Task], options: Options, started: float,
     counts = {s: sum(t.status == s for t in tasks) for s in ("rendered", "skipped", "failed")}
     if interrupted:
         counts["interrupted"] = sum(t.status == "interrupted" for t in tasks)
-    summary = {
+    summary: dict[str, Any] = {
         "opaline": __version__,
         "out": str(options.out),
         "server": options.server,

@@ -93,7 +93,7 @@ def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
     return overrides
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser(
         "batch", help="render folders of material files or manifests to thumbnails",
         description="Render material files (TOML/JSON), folders of them (recursive) and "

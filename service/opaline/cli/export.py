@@ -45,7 +45,7 @@ def cmd_import(args: argparse.Namespace) -> None:
     write_output(args.output, material_file_text(fields).encode())
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     export = sub.add_parser("export", help="a material as a GLSL function (.glsl) or as glTF "
                                            "with its mesh (.glb)")
     add_source(export, "export this mesh instead of the preset's")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
-from typing import get_args
+from typing import Any, get_args
 
 from opaline.cli.args import add_common
 from opaline.model.params import Material, Quality, RenderRequest
@@ -13,7 +13,7 @@ from opaline.output.files import write_atomic
 
 # The paper's MDF figures. Figs. 2, 6, 7 are single-channel (no rotation);
 # Figs. 3 and 8 rotate G and B.
-MDF_FIGURES: dict[str, dict[str, object]] = {
+MDF_FIGURES: dict[str, dict[str, Any]] = {
     "fig2a-ashikhmin-ex100-ey10": {
         "mdf": "ashikhmin",
         "ex": 100,
@@ -57,7 +57,7 @@ def build_gallery(
     size: int = 256,
     mdf_size: int = 256,
     backend: str | None = None,
-    quality: str = "standard",
+    quality: Quality = "standard",
 ) -> dict[str, list[str]]:
     from opaline.local.pipeline import LocalRenderer
     from opaline.model.presets import all_presets
@@ -85,7 +85,7 @@ def cmd_gallery(args: argparse.Namespace) -> None:
     )
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser(
         "gallery", help="render every preset and the paper's MDF figures (README pictures)"
     )

@@ -17,10 +17,11 @@ import os
 import signal
 import sys
 from pathlib import Path
+from typing import Any
 
 from opaline import __version__
 from opaline.cli import batch, export, gallery, merge, render, schema, serve, turntable
-from opaline.cli.args import CliError
+from opaline.cli.args import CliError, add_common
 from opaline.model.material_file import MaterialError
 from opaline.model.meshes import MeshFileMissing
 from opaline.model.params import RenderRequest
@@ -75,7 +76,7 @@ def cmd_info(args: argparse.Namespace) -> None:
 def add_global(parser: argparse.ArgumentParser, presets: bool, top: bool = False) -> None:
     """-q/-v (and --presets-dir) before or after the sub-command: a sub-command's copy has no
     default, so it does not undo a value given before the sub-command."""
-    default = {} if top else {"default": argparse.SUPPRESS}
+    default: dict[str, Any] = {} if top else {"default": argparse.SUPPRESS}
     loudness = parser.add_mutually_exclusive_group()
     loudness.add_argument("-q", "--quiet", action="store_true", **default,
                           help="no progress or information on stderr; errors only")
@@ -102,7 +103,7 @@ def make_parser() -> argparse.ArgumentParser:
     presets.set_defaults(func=cmd_presets)
 
     info = sub.add_parser("info", help="report the GL backend and renderer Opaline gets")
-    render.add_common(info)
+    add_common(info)
     info.set_defaults(func=cmd_info)
 
     for module in (gallery, serve, batch, merge, schema, turntable, export):

@@ -11,13 +11,17 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from opaline.cli.args import CliError, write_output
 from opaline.cli.batch import report_path
 from opaline.output.files import write_atomic
 
+if TYPE_CHECKING:
+    from opaline.batch.plan import Task
 
-def read_summary(path: str) -> dict:
+
+def read_summary(path: str) -> dict[str, Any]:
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
@@ -25,6 +29,16 @@ def read_summary(path: str) -> dict:
     if not isinstance(data, dict) or not isinstance(data.get("items"), list):
         raise CliError(f"{path}: not a batch summary (no items)")
     return data
+
+
+def _missing_outputs(tasks: list[Task]) -> list[str]:
+    missing = []
+    for t in tasks:
+        if t.written:
+            assert t.output is not None  # a written item names its output file
+            if not t.output.is_file():
+                missing.append(str(t.output))
+    return missing
 
 
 def cmd_merge(args: argparse.Namespace) -> None:
@@ -41,7 +55,7 @@ def cmd_merge(args: argparse.Namespace) -> None:
         raise CliError(str(exc)) from None
     tasks = tasks_from_summary(merged)
     if args.sheet:
-        missing = [str(t.output) for t in tasks if t.written and not t.output.is_file()]
+        missing = _missing_outputs(tasks)
         if missing:
             raise CliError(f"{len(missing)} output(s) missing from {out} (copy every shard's "
                            f"output folder into it first), e.g. {missing[0]}")
@@ -59,7 +73,7 @@ def cmd_merge(args: argparse.Namespace) -> None:
         raise SystemExit(1)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser(
         "batch-merge", help="join the summaries (and contact sheet) of a sharded batch",
         description="Merge the summaries of every shard of `opaline batch --shard K/N` into "

@@ -84,7 +84,7 @@ def add_output(parser: argparse.ArgumentParser) -> None:
                              "--format is given; '-' writes to stdout (png by default)")
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     fmt = argparse.RawDescriptionHelpFormatter
     render = sub.add_parser("render", help="render a preset or a material file to an image",
                             epilog=parameter_help(), formatter_class=fmt)

@@ -36,7 +36,7 @@ def cmd_serve(args: argparse.Namespace) -> None:
                 limit_concurrency=None, timeout_graceful_shutdown=10)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     serve = sub.add_parser(
         "serve", help="run the HTTP service",
         description="Serve the HTTP API (docs at /docs). Every setting can also come from an "

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import logging
 import time
+from typing import TYPE_CHECKING, get_args
 
 from opaline.cli.args import (
     CliError,
@@ -17,8 +18,11 @@ from opaline.cli.args import (
 )
 from opaline.model.params import Quality
 
+if TYPE_CHECKING:
+    from opaline.model.turntable import AnimationFormat
+
 log = logging.getLogger("opaline.cli")
-SUFFIXES = {".webp": "webp", ".gif": "gif", ".mp4": "mp4"}
+SUFFIXES: dict[str, AnimationFormat] = {".webp": "webp", ".gif": "gif", ".mp4": "mp4"}
 
 
 def cmd_turntable(args: argparse.Namespace) -> None:
@@ -48,14 +52,14 @@ def cmd_turntable(args: argparse.Namespace) -> None:
     write_output(args.output, data)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser("turntable", help="render the object from every side: an animated "
                                               "WebP, GIF or MP4")
     add_source(parser, "draw this mesh file instead")
     parser.add_argument("--frames", type=int, default=36, help="frames in one turn (default 36)")
     parser.add_argument("--fps", type=int, default=24, help="frames per second (default 24)")
     parser.add_argument("--size", metavar="WxH", help="frame size (default 256x256)")
-    parser.add_argument("--quality", choices=list(Quality.__args__), help="quality tier")
+    parser.add_argument("--quality", choices=list(get_args(Quality)), help="quality tier")
     parser.add_argument("--format", choices=["webp", "gif", "mp4"],
                         help="default: from the -o extension")
     parser.add_argument("-o", "--output", required=True, metavar="FILE", help="output file")

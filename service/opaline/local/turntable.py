@@ -52,7 +52,10 @@ def turntable_bytes(local: LocalRenderer, request: TurntableRequest,
     jobs = frame_jobs(job, preset, request.frames)
     for index, frame_job in enumerate(jobs, 1):
         frame = local.renderer.render(frame_job, preset)
-        pixels = frame.pixels if frame.pixels is not None else quantise(frame.display, 8)
+        pixels = frame.pixels
+        if pixels is None:
+            assert frame.display is not None  # a frame without 8-bit pixels has display values
+            pixels = quantise(frame.display, 8)
         frames.append(np.ascontiguousarray(pixels[..., :3]))
         if progress is not None:
             progress(index, len(jobs))

@@ -21,18 +21,30 @@ Each function mirrors the GLSL function of the same name in glsl/lib/grating.gls
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from opaline.model import visible
-from opaline.model.microfacet import EPS_DENOM, fresnel_schlick, mdf_ashikhmin
+from opaline.model.microfacet import (
+    EPS_DENOM,
+    FloatArray,
+    Frame,
+    Values,
+    fresnel_schlick,
+    mdf_ashikhmin,
+)
 from opaline.model.spectrum import rgb_weights, sample_wavelengths
+
+if TYPE_CHECKING:
+    from opaline.model.params import Material
 
 BESSEL_TERMS = 24  # series terms: below 1e-9 of the sum for a ≤ 7 (depth ≤ 400 nm)
 EPS_K2 = 1e-12
 
 
-def bessel_j(m: int, x):
+def bessel_j(m: int, x: npt.ArrayLike) -> FloatArray:
     """J_m(x) from its power series Σ_k (-1)^k (x/2)^(2k+m) / (k!(k+m)!), as the shader does."""
     x = np.asarray(x, dtype=np.float64)
     half = 0.5 * x
@@ -45,17 +57,19 @@ def bessel_j(m: int, x):
     return total
 
 
-def efficiency(m: int, lam_nm, depth_nm, kn):
+def efficiency(m: int, lam_nm: Values, depth_nm: float, kn: FloatArray) -> FloatArray:
     """η_m = J_|m|(a)², a = π·depth·(n·(l+v))/λ."""
     return bessel_j(abs(m), np.pi * depth_nm * kn / lam_nm) ** 2
 
 
-def _local(frame, x):
+def _local(frame: Frame, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     t, b, n = frame
     return np.sum(x * t, axis=-1), np.sum(x * b, axis=-1), np.sum(x * n, axis=-1)
 
 
-def order_lobe(material, frame, l, v, m: int, lam_nm):
+def order_lobe(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, m: int, lam_nm: Values
+) -> FloatArray:
     """One order's lobe at one wavelength, without ks and η: F·D(h_m)·(v·h_m)/(|k_m|²·max(n·l, n·v))."""
     kt, kb, kn = _local(frame, l + v)
     vt, vb, vn = _local(frame, v)
@@ -66,24 +80,32 @@ def order_lobe(material, frame, l, v, m: int, lam_nm):
     d = mdf_ashikhmin(kt / k_len, kb / k_len, kn / k_len, material.ex, material.ey)
     vh = (vt * kt + vb * kb + vn * kn) / k_len
     f = fresnel_schlick(material.f0, vh)
-    return f * d * np.maximum(vh, 0.0) / (k2 * np.maximum(np.maximum(ln, vn), EPS_DENOM))
+    lobe: FloatArray = (f * d * np.maximum(vh, 0.0)
+                        / (k2 * np.maximum(np.maximum(ln, vn), EPS_DENOM)))
+    return lobe
 
 
-def order_term(material, frame, l, v, m: int, lam_nm):
+def order_term(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, m: int, lam_nm: Values
+) -> FloatArray:
     """η_m(λ) times the order's lobe."""
     kn = np.maximum(_local(frame, l + v)[2], 0.0)
     eta = efficiency(m, lam_nm, material.grating_depth, kn)
     return eta * order_lobe(material, frame, l, v, m, lam_nm)
 
 
-def grating_spectral(material, frame, l, v, wavelengths):
+def grating_spectral(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, wavelengths: int
+) -> FloatArray:
     """Σ_i w_i Σ_{|m| ≤ M} term(m, λ_i): per-wavelength, integrated to linear sRGB."""
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
     orders = material.grating_orders
-    total = 0.0
+    total: Values = 0.0
     for lam_i, w in zip(lam, weights, strict=True):
-        s = sum(order_term(material, frame, l, v, m, lam_i) for m in range(-orders, orders + 1))
+        # Orders -1, 0 and 1 at least: never the empty sum's 0.
+        s = cast(FloatArray, sum(order_term(material, frame, l, v, m, lam_i)
+                                 for m in range(-orders, orders + 1)))
         total = total + s[..., None] * w
     return np.maximum(total, 0.0)
 
@@ -91,10 +113,11 @@ def grating_spectral(material, frame, l, v, wavelengths):
 def channel_wavelengths() -> np.ndarray:
     """Centroid of each channel's weight (nm): where the fast path evaluates η_0."""
     grid, table = visible.density_table()
-    return np.sum(grid[:, None] * table, axis=0) / np.sum(table, axis=0)
+    centroid: np.ndarray = np.sum(grid[:, None] * table, axis=0) / np.sum(table, axis=0)
+    return centroid
 
 
-def grating_fast(material, frame, l, v):
+def grating_fast(material: Material, frame: Frame, l: FloatArray, v: FloatArray) -> FloatArray:
     """Each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999's idea).
 
     The lobe's extent in λ is integrated in closed form under a Gaussian
@@ -112,7 +135,7 @@ def grating_fast(material, frame, l, v):
     base = fresnel_schlick(material.f0, vh0) * d0 * np.maximum(vh0, 0.0)
     base = base / (k0_sq * np.maximum(np.maximum(ln, vn), EPS_DENOM))
     kn_pos = np.maximum(kn, 0.0)
-    total = 0.0
+    total: Values = 0.0
     for m in range(1, material.grating_orders + 1):
         for sign in (1, -1):
             lam = sign * pitch_nm * kb / m

@@ -142,8 +142,9 @@ def _optional(name: str) -> Any:
     """``Material``'s field ``name`` as an override: the same type, range, description and
     extras, ``None`` by default."""
     field = Material.model_fields[name]
-    annotation = Annotated[(field.annotation, *field.metadata)] if field.metadata else \
-        field.annotation
+    annotation: Any = field.annotation
+    if field.metadata:  # the range (ge, le) pydantic keeps apart from the type
+        annotation = Annotated[(annotation, *field.metadata)]
     return (annotation | None, Field(None, description=field.description,
                                      json_schema_extra=field.json_schema_extra))
 

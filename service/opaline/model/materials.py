@@ -84,7 +84,7 @@ def manifest_items(path: Path, prefix: str, overrides: dict[str, Any]) -> list[I
             for index, entry in enumerate(entries)]
 
 
-def _manifest_parts(path: Path, data: dict) -> tuple[list, dict]:
+def _manifest_parts(path: Path, data: dict[str, Any]) -> tuple[list[Any], dict[str, Any]]:
     unknown = sorted(set(data) - MANIFEST_KEYS)
     if unknown:
         raise MaterialError(f"{path}: unknown key(s) {', '.join(unknown)} "
@@ -98,7 +98,7 @@ def _manifest_parts(path: Path, data: dict) -> tuple[list, dict]:
     return entries, defaults
 
 
-def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict, prefix: str,
+def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any], prefix: str,
                 overrides: dict[str, Any]) -> Item:
     where = f"{manifest}[material {index + 1}]"
     if not isinstance(entry, dict):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
+from typing import Any
 
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
@@ -28,10 +29,11 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
     """``base`` drawing the mesh at ``path``: its lights, background and
     defaults, the camera framed on the mesh by the renderer, no normal map (the
     mesh's UVs were not made for the preset's map)."""
-    args = {"kind": MESH_KIND, "path": str(path), "digest": digest,
-            "tangent_field": request.tangent_field or "auto",
-            "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
-            "max_triangles": max_triangles}
+    # The generator's arguments (scene.meshfile.mesh_file's), of their several types.
+    args: dict[str, Any] = {"kind": MESH_KIND, "path": str(path), "digest": digest,
+                            "tangent_field": request.tangent_field or "auto",
+                            "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
+                            "max_triangles": max_triangles}
     return base.model_copy(update={"name": f"mesh-{digest[:12]}",
                                    "geometry": Generator(**args), "normal_map": None,
                                    "tangents": "uv", "rotation_deg": (0.0, 0.0, 0.0)})

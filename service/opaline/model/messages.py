@@ -11,6 +11,7 @@ import math
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
+from pydantic.fields import FieldInfo
 
 TWO_PI = 2.0 * math.pi
 
@@ -34,7 +35,7 @@ def field_range(model: type[BaseModel], name: str) -> str | None:
     return f"{'(' if lo_open else '['}{_fmt(lo)} … {_fmt(hi)}{')' if hi_open else ']'}"
 
 
-def _constraints(info) -> list[Any]:
+def _constraints(info: FieldInfo) -> list[Any]:
     found = list(info.metadata)
     annotation = info.annotation
     for arg in getattr(annotation, "__args__", ()) or ():
@@ -80,7 +81,7 @@ def _nested_model(annotation: Any) -> type[BaseModel] | None:
     return None
 
 
-def _owner(model: type[BaseModel], loc: tuple) -> tuple[type[BaseModel], str]:
+def _owner(model: type[BaseModel], loc: tuple[int | str, ...]) -> tuple[type[BaseModel], str]:
     """The (possibly nested) model that owns the last named field of an error location."""
     owner, name = model, "request"
     current: type[BaseModel] | None = model

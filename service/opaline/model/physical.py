@@ -7,17 +7,30 @@ branches of glsl/lib/reflectance.glsl; ``reference.specular`` hands over to
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+import numpy.typing as npt
 
 from opaline.model import grating, thinfilm
-from opaline.model.microfacet import EPS_DENOM, EPS_HALF, mdf_ashikhmin
+from opaline.model.microfacet import EPS_DENOM, EPS_HALF, FloatArray, Frame, mdf_ashikhmin
+
+if TYPE_CHECKING:
+    from opaline.model.params import Material
 
 
-def is_physical(material) -> bool:
+def is_physical(material: Material) -> bool:
     return getattr(material, "iridescence", "rotation") != "rotation"
 
 
-def specular_thin_film(material, frame, l, v, wavelengths=0, thickness_nm=None):
+def specular_thin_film(
+    material: Material,
+    frame: Frame,
+    l: FloatArray,
+    v: FloatArray,
+    wavelengths: int = 0,
+    thickness_nm: npt.ArrayLike | None = None,
+) -> FloatArray:
     """ks·D(h)·R_film(v·h)/(4·(v·h)·max(n·l, n·v)): the paper's reflectance with the
     Airy reflectance of the film in place of Fresnel, and the unrotated A-S lobe."""
     t, b, n = frame
@@ -38,7 +51,9 @@ def specular_thin_film(material, frame, l, v, wavelengths=0, thickness_nm=None):
     return np.where(length > EPS_HALF, spec, 0.0)
 
 
-def specular_grating(material, frame, l, v, wavelengths=0):
+def specular_grating(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, wavelengths: int = 0
+) -> FloatArray:
     if wavelengths > 0:
         colour = grating.grating_spectral(material, frame, l, v, wavelengths)
     else:
@@ -46,7 +61,9 @@ def specular_grating(material, frame, l, v, wavelengths=0):
     return material.ks * colour
 
 
-def specular(material, frame, l, v, wavelengths=0):
+def specular(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, wavelengths: int = 0
+) -> FloatArray:
     if material.iridescence == "thin-film":
         return specular_thin_film(material, frame, l, v, wavelengths)
     return specular_grating(material, frame, l, v, wavelengths)

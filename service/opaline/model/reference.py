@@ -9,40 +9,60 @@ reflectance around the MDF; Schlick 1994 for the Fresnel term.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+import numpy.typing as npt
 
 from opaline.model.microfacet import (  # noqa: F401 (re-exported: the reference in one place)
     EPS_DENOM,
     EPS_HALF,
+    FloatArray,
+    Frame,
+    Values,
     fresnel_schlick,
     log1p_ratio,
     mdf_ashikhmin,
 )
 from opaline.model.spectrum import CENTRE, rgb_weights, rotation_at, sample_wavelengths
 
+if TYPE_CHECKING:
+    from opaline.model.params import Material
+
 TWO_PI = 2.0 * np.pi
 
 
-def rotate_half(hx, hy, theta):
+def rotate_half(hx: FloatArray, hy: FloatArray, theta: float) -> tuple[FloatArray, FloatArray]:
     """Eq. 2: rotate the projected half vector counter-clockwise by ``theta``."""
     c, s = np.cos(theta), np.sin(theta)
     return c * hx - s * hy, s * hx + c * hy
 
 
-def mdf_multipeak(hx, hy, hz, mu_f, alpha, beta):
+def mdf_multipeak(
+    hx: FloatArray, hy: FloatArray, hz: FloatArray, mu_f: float, alpha: float, beta: float
+) -> FloatArray:
     """Eqs. 3-4: ½·max(hz, 0)·(cos(2π·mu_f·r) + 1), r = sqrt(α·hx² + β·hy²)."""
     r = np.sqrt(alpha * hx * hx + beta * hy * hy)
     return 0.5 * np.maximum(hz, 0.0) * (np.cos(TWO_PI * mu_f * r) + 1.0)
 
 
-def sinc_half(footprint):
+def sinc_half(footprint: npt.ArrayLike) -> FloatArray:
     """sin(Δ/2)/(Δ/2): the mean of cos over a phase interval of width Δ, per unit cos."""
     half = 0.5 * np.asarray(footprint, dtype=np.float64)
     safe = np.where(half > 1e-4, half, 1.0)
     return np.where(half > 1e-4, np.sin(half) / safe, 1.0 - half * half / 6.0)
 
 
-def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint, footprint_y=0.0):
+def mdf_multipeak_filtered(
+    hx: FloatArray,
+    hy: FloatArray,
+    hz: FloatArray,
+    mu_f: float,
+    alpha: float,
+    beta: float,
+    footprint: npt.ArrayLike,
+    footprint_y: npt.ArrayLike = 0.0,
+) -> FloatArray:
     """Eq. 4 with the cosine box-filtered over the pixel (docs/design.md §4.2).
 
     ``footprint`` and ``footprint_y`` are how far the phase moves (radians) across the
@@ -56,14 +76,21 @@ def mdf_multipeak_filtered(hx, hy, hz, mu_f, alpha, beta, footprint, footprint_y
     return 0.5 * np.maximum(hz, 0.0) * (band + 1.0)
 
 
-def mdf(material, hx, hy, hz):
+def mdf(material: Material, hx: FloatArray, hy: FloatArray, hz: FloatArray) -> FloatArray:
     """The material's MDF at an unrotated projected half vector."""
     if material.mdf == "ashikhmin":
         return mdf_ashikhmin(hx, hy, hz, material.ex, material.ey)
     return mdf_multipeak(hx, hy, hz, material.mu_f, material.alpha, material.beta)
 
 
-def mdf_rgb(material, hx, hy, hz, wavelengths=0, shift=CENTRE):
+def mdf_rgb(
+    material: Material,
+    hx: FloatArray,
+    hy: FloatArray,
+    hz: FloatArray,
+    wavelengths: int = 0,
+    shift: float = CENTRE,
+) -> FloatArray:
     """D for R, G, B: the MDF at half vectors rotated by 0, θ1, θ2 (eq. 2), or,
     with ``wavelengths`` > 0, per wavelength (at ``shift`` through each bin) and integrated
     to linear sRGB."""
@@ -71,7 +98,7 @@ def mdf_rgb(material, hx, hy, hz, wavelengths=0, shift=CENTRE):
         lam = sample_wavelengths(wavelengths, shift)
         thetas = rotation_at(lam, material.theta1, material.theta2)
         weights = rgb_weights(wavelengths, shift)
-        total = 0.0
+        total: Values = 0.0
         for theta, weight in zip(thetas, weights, strict=True):
             rx, ry = rotate_half(hx, hy, theta)
             total = total + mdf(material, rx, ry, hz)[..., None] * weight
@@ -83,12 +110,13 @@ def mdf_rgb(material, hx, hy, hz, wavelengths=0, shift=CENTRE):
     return np.stack(out, axis=-1)
 
 
-def normalize(v):
+def normalize(v: FloatArray) -> FloatArray:
     length = np.linalg.norm(v, axis=-1, keepdims=True)
-    return v / np.maximum(length, 1e-30)
+    unit: FloatArray = v / np.maximum(length, 1e-30)
+    return unit
 
 
-def shading_frame(n, t):
+def shading_frame(n: FloatArray, t: FloatArray) -> Frame:
     """Orthonormal (t, b, n): t made perpendicular to n; a t along n is replaced."""
     n = normalize(n)
     t = t - n * np.sum(n * t, axis=-1, keepdims=True)
@@ -104,12 +132,21 @@ def shading_frame(n, t):
     return t, b, n
 
 
-def specular_rgb(material, n, t, l, v, wavelengths=0):
+def specular_rgb(
+    material: Material,
+    n: FloatArray,
+    t: FloatArray,
+    l: FloatArray,
+    v: FloatArray,
+    wavelengths: int = 0,
+) -> FloatArray:
     """``specular`` in the shading frame of ``n`` and ``t``."""
     return specular(material, shading_frame(n, t), l, v, wavelengths)
 
 
-def specular(material, frame, l, v, wavelengths=0):
+def specular(
+    material: Material, frame: Frame, l: FloatArray, v: FloatArray, wavelengths: int = 0
+) -> FloatArray:
     """ks·D_c·F/(4·(v·h)·max(n·l, n·v)) per channel in a (t, b, n) frame; zero where h is
     undefined."""
     if getattr(material, "iridescence", "rotation") != "rotation":
@@ -134,16 +171,24 @@ def specular(material, frame, l, v, wavelengths=0):
     return np.where(length > EPS_HALF, spec, 0.0)
 
 
-def reflected_radiance(material, n, t, l, v, wavelengths=0):
+def reflected_radiance(
+    material: Material,
+    n: FloatArray,
+    t: FloatArray,
+    l: FloatArray,
+    v: FloatArray,
+    wavelengths: int = 0,
+) -> FloatArray:
     """f·max(n·l, 0) for a light of unit irradiance, per channel (linear RGB)."""
     frame = shading_frame(n, t)
     nl = np.sum(frame[2] * l, axis=-1)
     diffuse = material.kd * np.asarray(material.albedo, dtype=np.float64) / np.pi
     f = diffuse + specular(material, frame, l, v, wavelengths)
-    return f * np.maximum(nl, 0.0)[..., None]
+    radiance: FloatArray = f * np.maximum(nl, 0.0)[..., None]
+    return radiance
 
 
-def mdf_plot_coords(size):
+def mdf_plot_coords(size: int) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
     """Pixel-centre hx, hy, hz of the N×N MDF plot (row 0 at the top, +hy up)."""
     centres = (np.arange(size, dtype=np.float64) + 0.5) / size * 2.0 - 1.0
     hx, hy = np.meshgrid(centres, centres[::-1])
@@ -152,7 +197,7 @@ def mdf_plot_coords(size):
     return hx, hy, hz, s2 < 1.0
 
 
-def mdf_plot(material, size, wavelengths=0):
+def mdf_plot(material: Material, size: int, wavelengths: int = 0) -> FloatArray:
     """The paper's Figs. 2, 3, 6, 7: D over the projected half-vector disc, R G B."""
     hx, hy, hz, inside = mdf_plot_coords(size)
     return np.where(inside[..., None], mdf_rgb(material, hx, hy, hz, wavelengths), 0.0)
@@ -161,7 +206,7 @@ def mdf_plot(material, size, wavelengths=0):
 # Display encoding (glsl/lib/display.glsl)
 
 
-def tonemap(x, mode):
+def tonemap(x: npt.ArrayLike, mode: str) -> FloatArray:
     x = np.maximum(x, 0.0)
     if mode == "reinhard":
         return x / (1.0 + x)
@@ -171,11 +216,11 @@ def tonemap(x, mode):
     return np.clip(x, 0.0, 1.0)
 
 
-def srgb_encode(x):
+def srgb_encode(x: npt.ArrayLike) -> FloatArray:
     x = np.clip(x, 0.0, 1.0)
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
 
 
-def srgb_decode(x):
+def srgb_decode(x: npt.ArrayLike) -> FloatArray:
     x = np.clip(x, 0.0, 1.0)
     return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))

@@ -21,4 +21,5 @@ def sample_offsets(count: int) -> np.ndarray:
         return np.zeros((1, 2))
     k = np.arange(count)[:, None]
     offsets = np.mod(0.5 + k * _A, 1.0) - 0.5
-    return offsets - offsets.mean(axis=0)
+    centred: np.ndarray = offsets - offsets.mean(axis=0)
+    return centred

@@ -47,7 +47,8 @@ def rotation_at(wavelengths: np.ndarray, theta1: float, theta2: float) -> np.nda
     lam = np.asarray(wavelengths, dtype=np.float64)
     xs = np.array(ANCHORS_NM[::-1])  # increasing: 465, 549, 612
     ys = np.array([theta2, theta1, 0.0])
-    return np.interp(lam, xs, ys)  # np.interp holds the end values outside xs
+    theta: np.ndarray = np.interp(lam, xs, ys)  # np.interp holds the end values outside xs
+    return theta
 
 
 # XYZ to linear sRGB (IEC 61966-2-1), the matrix colour-science uses for sRGB.
@@ -78,6 +79,6 @@ def cie_xyz(lam: np.ndarray) -> np.ndarray:
 def rgb_weights(count: int, shift: float = CENTRE) -> np.ndarray:
     """(count, 3) weights from per-wavelength D to linear sRGB; columns sum to 1."""
     rgb = cie_xyz(sample_wavelengths(count, shift)) @ XYZ_TO_SRGB.T
-    weights = rgb / rgb.sum(axis=0, keepdims=True)
+    weights: np.ndarray = rgb / rgb.sum(axis=0, keepdims=True)
     weights.setflags(write=False)  # cached and shared: a caller must not change it in place
     return weights

@@ -16,15 +16,24 @@ same name in glsl/lib/thin_film.glsl.
 
 from __future__ import annotations
 
+from typing import TypeAlias
+
 import numpy as np
+import numpy.typing as npt
 
 from opaline.model import visible
+from opaline.model.microfacet import FloatArray, Values
 from opaline.model.spectrum import rgb_weights, sample_wavelengths
+
+# Per polarisation (s, p): one Fresnel amplitude coefficient each.
+Amplitudes: TypeAlias = tuple[FloatArray, FloatArray]
 
 FAST_TERMS = 3  # Fourier terms of the fast path; |ab|^4 < 1e-3 below grazing
 
 
-def interfaces(cos1, n_film, n_sub):
+def interfaces(
+    cos1: npt.ArrayLike, n_film: float, n_sub: float
+) -> tuple[FloatArray, Amplitudes, Amplitudes, FloatArray]:
     """(cos θ2, r12 s/p, r23 s/p, tir): Fresnel amplitudes at both interfaces."""
     cos1 = np.clip(np.asarray(cos1, dtype=np.float64), 0.0, 1.0)
     # cos²θ2 = 1 - sin²θ1/n² written as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1
@@ -42,20 +51,23 @@ def interfaces(cos1, n_film, n_sub):
     return cos2, (r12s, r12p), (r23s, r23p), tir
 
 
-def _ratio(num, den):
+def _ratio(num: FloatArray, den: FloatArray) -> FloatArray:
     return num / np.where(np.abs(den) > 1e-30, den, 1e-30)
 
 
-def airy(a, b, phase):
+def airy(a: FloatArray, b: FloatArray, phase: FloatArray) -> FloatArray:
     """Reflectance of one polarisation: |a + b·e^{iφ}|² / |1 + ab·e^{iφ}|²."""
     ab = a * b
     c = np.cos(phase)
     # The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
-    num = np.maximum(a * a + b * b + 2.0 * ab * c, 0.0)
-    return num / np.maximum(1.0 + ab * ab + 2.0 * ab * c, 1e-30)
+    num: FloatArray = np.maximum(a * a + b * b + 2.0 * ab * c, 0.0)
+    den: FloatArray = np.maximum(1.0 + ab * ab + 2.0 * ab * c, 1e-30)
+    return num / den
 
 
-def film_reflectance(cos1, lam_nm, d_nm, n_film, n_sub):
+def film_reflectance(
+    cos1: npt.ArrayLike, lam_nm: Values, d_nm: Values, n_film: float, n_sub: float
+) -> FloatArray:
     """Airy reflectance averaged over s and p at wavelength ``lam_nm`` (broadcasts)."""
     cos2, (r12s, r12p), (r23s, r23p), tir = interfaces(cos1, n_film, n_sub)
     phase = 4.0 * np.pi * n_film * d_nm * cos2 / lam_nm
@@ -63,16 +75,21 @@ def film_reflectance(cos1, lam_nm, d_nm, n_film, n_sub):
     return np.where(tir, 1.0, r)
 
 
-def film_rgb_spectral(cos1, d_nm, n_film, n_sub, wavelengths):
+def film_rgb_spectral(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float, wavelengths: int
+) -> FloatArray:
     """Σ_i w_i·R(λ_i): ``wavelengths`` bins over 380-780 nm, CIE 1931 to linear sRGB."""
     cos1 = np.asarray(cos1, dtype=np.float64)
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
     r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub)
-    return np.maximum(r @ weights, 0.0)
+    rgb: FloatArray = np.maximum(r @ weights, 0.0)
+    return rgb
 
 
-def film_rgb_fast(cos1, d_nm, n_film, n_sub):
+def film_rgb_fast(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float
+) -> FloatArray:
     """Belcour & Barla 2017's evaluation: R(φ) as a Fourier series in φ, each term
     integrated against the colour weights in closed form (``visible.sensitivity``).
 
@@ -85,7 +102,7 @@ def film_rgb_fast(cos1, d_nm, n_film, n_sub):
     cos1 = np.asarray(cos1, dtype=np.float64)
     cos2, r12, r23, tir = interfaces(cos1, n_film, n_sub)
     opd_um = 2e-3 * n_film * np.asarray(d_nm, dtype=np.float64) * cos2
-    total = 0.0
+    total: Values = 0.0
     for a, b in zip(r12, r23, strict=True):
         x = a * b
         one_minus = np.maximum(1.0 - x * x, 1e-30)
@@ -101,14 +118,14 @@ def film_rgb_fast(cos1, d_nm, n_film, n_sub):
     return np.maximum(np.where(tir[..., None], 1.0, total), 0.0)
 
 
-def film_tail(x_abs, opd_um, shift):
+def film_tail(x_abs: npt.ArrayLike, opd_um: npt.ArrayLike, shift: npt.ArrayLike) -> Values:
     """Σ_{m > M} |x|^m·∫ ŵ cos(m(2π·opd·ν + shift)) dν, each Gaussian at its centre:
     Re(z^(M+1)/(1 - z)) with z = |x|·e^{iθ}, damped as the term m = M + 1."""
     g = visible.sensitivity_gaussians()
     big_m = FAST_TERMS
     x = np.asarray(x_abs)[..., None]
     opd = np.asarray(opd_um)[..., None]
-    total = 0.0
+    total: Values = 0.0
     for k in range(g.shape[0]):
         weight, centre, sigma = g[k, :, 0], g[k, :, 1], g[k, :, 2]
         theta = 2.0 * np.pi * centre * opd + np.asarray(shift)[..., None]
@@ -119,7 +136,9 @@ def film_tail(x_abs, opd_um, shift):
     return total
 
 
-def film_rgb(cos1, d_nm, n_film, n_sub, wavelengths=0):
+def film_rgb(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float, wavelengths: int = 0
+) -> FloatArray:
     if wavelengths > 0:
         return film_rgb_spectral(cos1, d_nm, n_film, n_sub, wavelengths)
     return film_rgb_fast(cos1, d_nm, n_film, n_sub)

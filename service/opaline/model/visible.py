@@ -23,7 +23,9 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
+import numpy.typing as npt
 
+from opaline.model.microfacet import Values
 from opaline.model.spectrum import RANGE_NM, XYZ_TO_SRGB, cie_xyz
 
 TABLE_STEP_NM = 5.0
@@ -56,7 +58,7 @@ def density_table() -> tuple[np.ndarray, np.ndarray]:
     return grid, table
 
 
-def density_at(lam_nm) -> np.ndarray:
+def density_at(lam_nm: npt.ArrayLike) -> np.ndarray:
     """ŵ(λ) per nm by linear interpolation in the table; 0 outside the visible range.
 
     Mirrors ``visible_density`` in glsl/lib/grating.glsl."""
@@ -84,7 +86,7 @@ def sensitivity_gaussians() -> np.ndarray:
     return out
 
 
-def sensitivity(opd_um, shift) -> np.ndarray:
+def sensitivity(opd_um: npt.ArrayLike, shift: npt.ArrayLike) -> Values:
     """∫ ŵ_c(ν) cos(2π·opd·ν + shift) dν per channel, in closed form from the Gaussians.
 
     Mirrors ``film_sensitivity`` in glsl/lib/thin_film.glsl. ``opd_um``: optical path
@@ -92,7 +94,7 @@ def sensitivity(opd_um, shift) -> np.ndarray:
     g = sensitivity_gaussians()
     opd = np.asarray(opd_um, dtype=np.float64)[..., None]
     shift = np.asarray(shift, dtype=np.float64)[..., None]
-    total = 0.0
+    total: Values = 0.0
     for k in range(g.shape[0]):
         weight, centre, sigma = g[k, :, 0], g[k, :, 1], g[k, :, 2]
         damp = np.exp(-2.0 * (np.pi * sigma * opd) ** 2)

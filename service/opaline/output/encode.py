@@ -14,15 +14,22 @@ from __future__ import annotations
 import io
 import struct
 import zlib
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from opaline.output.formats import LOSSY, encode_pillow
+
+if TYPE_CHECKING:
+    from opaline.gl.buffers import Frame
+
+# Either module: both have compress(data, level).
+deflater: ModuleType
 try:
     from isal import isal_zlib as deflater
 except ImportError:  # pragma: no cover - isal is a dependency; zlib is the fallback
     deflater = zlib
-
-from opaline.output.formats import LOSSY, encode_pillow
 
 MEDIA_TYPES = {"png": "image/png", "png16": "image/png", "npy": "application/x-npy",
                "webp": "image/webp", "webp-lossless": "image/webp", "avif": "image/avif",
@@ -36,7 +43,7 @@ SRGB = b"\x00"  # sRGB chunk, perceptual intent: the pixels are sRGB-encoded
 
 def quantise(display: np.ndarray, bits: int) -> np.ndarray:
     top = (1 << bits) - 1
-    scaled = np.rint(np.clip(display, 0.0, 1.0) * top)
+    scaled: np.ndarray = np.rint(np.clip(display, 0.0, 1.0) * top)
     return scaled.astype(np.uint8 if bits == 8 else np.uint16)
 
 
@@ -85,13 +92,16 @@ def npy(array: np.ndarray) -> bytes:
     return out.getvalue()
 
 
-def encode_frame(frame, fmt: str, alpha: bool = False) -> bytes:
+def encode_frame(frame: Frame, fmt: str, alpha: bool = False) -> bytes:
     if fmt == "npy":
+        assert frame.linear is not None  # the renderer reads linear pixels for npy
         return npy(frame.linear)
     if fmt == "png16":
+        assert frame.display is not None  # and display values for 16 bits
         return png16(frame.display, alpha)
     pixels = getattr(frame, "pixels", None)
     if pixels is None:  # a float frame (the Python API's arrays, tests)
+        assert frame.display is not None  # a frame without pixels has display values
         pixels = quantise(frame.display[..., :4 if alpha else 3], 8)
     if fmt == "png":
         return png_pixels(pixels)

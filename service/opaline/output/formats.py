@@ -16,7 +16,7 @@ import numpy as np
 LOSSY = frozenset({"webp", "avif", "jpeg"})
 HAS_ALPHA = frozenset({"png", "png16", "webp", "webp-lossless", "avif", "npy"})
 # Pillow save arguments per format.
-SETTINGS: dict[str, tuple[str, dict]] = {
+SETTINGS: dict[str, tuple[str, dict[str, int | bool]]] = {
     "webp": ("WEBP", {"quality": 85, "method": 0}),
     "webp-lossless": ("WEBP", {"lossless": True, "quality": 0, "method": 0, "exact": True}),
     "avif": ("AVIF", {"quality": 75, "speed": 10}),

@@ -35,7 +35,8 @@ class EnvironmentMapError(ValueError):
     """An environment that is not known or cannot be read; the message says which."""
 
 
-def _box(d: np.ndarray, centre, half_width: float, half_height: float) -> np.ndarray:
+def _box(d: np.ndarray, centre: tuple[float, float, float], half_width: float,
+         half_height: float) -> np.ndarray:
     """1 inside a rectangle of angular half-sizes (radians) facing ``centre``, soft edges."""
     c = np.asarray(centre, dtype=np.float64)
     c /= np.linalg.norm(c)
@@ -46,7 +47,8 @@ def _box(d: np.ndarray, centre, half_width: float, half_height: float) -> np.nda
     x = np.arctan2(d @ right, facing)
     y = np.arctan2(d @ up, facing)
     edge = np.maximum(np.abs(x) / half_width, np.abs(y) / half_height)
-    return np.clip((1.15 - edge) / 0.3, 0.0, 1.0) * (facing > 0)
+    weight: np.ndarray = np.clip((1.15 - edge) / 0.3, 0.0, 1.0) * (facing > 0)
+    return weight
 
 
 def studio() -> np.ndarray:
@@ -56,7 +58,8 @@ def studio() -> np.ndarray:
     key = _box(d, (0.6, 0.9, 0.8), 0.45, 0.3)[..., None] * np.array([2.0, 1.95, 1.85])
     strip = _box(d, (-1.0, 0.25, 0.2), 0.12, 0.55)[..., None] * np.array([1.1, 1.15, 1.25])
     rim = _box(d, (0.2, 0.4, -1.0), 0.3, 0.2)[..., None] * np.array([0.5, 0.5, 0.5])
-    return (room + key + strip + rim).astype(np.float32)
+    radiance: np.ndarray = room + key + strip + rim
+    return radiance.astype(np.float32)
 
 
 def sky() -> np.ndarray:
@@ -71,7 +74,8 @@ def sky() -> np.ndarray:
     # A disc 2.5° across (wider than the real 0.53°, so 1.4° texels resolve it) carrying
     # about three times the sky's irradiance, as on a clear day.
     sun = (d @ sun_dir > np.cos(np.radians(1.25)))[..., None]
-    return (radiance + sun * np.array([1.0, 0.95, 0.88]) * 2400.0).astype(np.float32)
+    lit: np.ndarray = radiance + sun * np.array([1.0, 0.95, 0.88]) * 2400.0
+    return lit.astype(np.float32)
 
 
 def read_file(path: Path) -> np.ndarray:
@@ -91,10 +95,10 @@ def read_file(path: Path) -> np.ndarray:
         else:
             import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
 
-            image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-            if image is None:
+            decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+            if decoded is None:
                 raise ValueError("not a Radiance .hdr image")
-            image = np.asarray(image, dtype=np.float32)[..., 2::-1]
+            image = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
     except ImportError as exc:
         raise EnvironmentMapError(f"environment {path.name}: reading {suffix} files needs "
                                   f"{exc.name}, a dependency of opaline: reinstall it") from None
@@ -126,7 +130,8 @@ def resolve_map(name: str, folder: Path | None) -> np.ndarray:
     return studio() if name == "studio" else sky()
 
 
-_lights: OrderedDict[tuple, tuple[np.ndarray, np.ndarray]] = OrderedDict()
+# (name, count, folder) -> (directions, irradiances)
+_lights: OrderedDict[tuple[str, int, str], tuple[np.ndarray, np.ndarray]] = OrderedDict()
 
 
 def environment_lights(name: str, count: int, rotation_deg: float = 0.0, intensity: float = 1.0,

@@ -11,13 +11,22 @@ import inspect
 import math
 import numbers
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
+T = TypeVar("T")
+
+
+def _is_number(value: Any, kind: type) -> bool:
+    """A number of ``kind`` that is not a bool (True is an Integral to Python, not to us).
+
+    Not a type guard: the checks below compare ``value`` as given, whatever number it is."""
+    return not isinstance(value, bool) and isinstance(value, kind)
+
 
 def integer(name: str, value: Any, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+    if not _is_number(value, numbers.Integral):
         raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value!r}")
     if not lo <= value <= hi:
         raise ValueError(f"argument '{name}' must be an integer from {lo} to {hi}, got {value}")
@@ -27,21 +36,21 @@ def integer(name: str, value: Any, lo: int, hi: int) -> int:
 def real(name: str, value: Any, lo: float | None = None, hi: float | None = None) -> float:
     bounded = lo is not None and hi is not None
     wanted = f"a number from {lo} to {hi}" if bounded else "a finite number"
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+    if not _is_number(value, numbers.Real) or not math.isfinite(value):
         raise ValueError(f"argument '{name}' must be {wanted}, got {value!r}")
-    if bounded and not lo <= value <= hi:
+    if lo is not None and hi is not None and not lo <= value <= hi:
         raise ValueError(f"argument '{name}' must be {wanted}, got {value}")
     return float(value)
 
 
 def positive(name: str, value: Any) -> float:
-    value = real(name, value)
-    if value <= 0.0:
-        raise ValueError(f"argument '{name}' must be > 0, got {value}")
-    return value
+    number = real(name, value)
+    if number <= 0.0:
+        raise ValueError(f"argument '{name}' must be > 0, got {number}")
+    return number
 
 
-def sequence(name: str, value: Any, length: int) -> Sequence:
+def sequence(name: str, value: Any, length: int) -> Sequence[Any] | np.ndarray:
     if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
         raise ValueError(f"argument '{name}' must be a sequence of {length} numbers, got {value!r}")
     if len(value) != length:
@@ -49,7 +58,7 @@ def sequence(name: str, value: Any, length: int) -> Sequence:
     return value
 
 
-def call(family: str, kinds: Mapping[str, Callable[..., Any]], kind: str, args: dict) -> Any:
+def call(family: str, kinds: Mapping[str, Callable[..., T]], kind: str, args: dict[str, Any]) -> T:
     """Call ``kinds[kind](**args)``, refusing unknown kinds and unknown or missing arguments."""
     factory = kinds.get(kind)
     if factory is None:

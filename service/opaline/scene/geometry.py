@@ -12,6 +12,7 @@ import inspect
 import math
 from collections.abc import Callable
 from functools import cache
+from typing import Any
 
 import numpy as np
 
@@ -104,8 +105,8 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
 
     # Row i = radius, column j = angle: (b-a)×(c-a) = (angle direction) × (radial
     # direction) = +y, so (a, b, c) and (b, d, c) are counter-clockwise from +y.
-    i, j = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
-    i, j = i.ravel(), j.ravel()
+    rows, cols = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
+    i, j = rows.ravel(), cols.ravel()
     jn = (j + 1) % segments
     a, b = i * segments + j, i * segments + jn
     c, d = a + segments, b + segments
@@ -132,13 +133,13 @@ def box(size: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> Mesh:
     mirror-like patch, and give each face its own full [0, 1] uv square so a
     normal map (the paper's perturbed cube) covers every face the same way.
     """
-    size = generators.sequence("size", size, 3)
-    half = np.array([generators.positive("size", s) for s in size]) * 0.5
+    sides = generators.sequence("size", size, 3)
+    half = np.array([generators.positive("size", s) for s in sides]) * 0.5
 
     corners = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)], dtype=np.float64)
     positions, normals, tangents, uvs, indices = [], [], [], [], []
-    for face, (n, t) in enumerate(_BOX_FACES):
-        n, t = np.array(n, dtype=np.float64), np.array(t, dtype=np.float64)
+    for face, (normal, tangent) in enumerate(_BOX_FACES):
+        n, t = np.array(normal, dtype=np.float64), np.array(tangent, dtype=np.float64)
         b = np.cross(n, t)
         for su, sv in corners:
             positions.append(half * (n + su * t + sv * b))
@@ -161,7 +162,7 @@ KINDS: dict[str, Callable[..., Mesh]] = {
 }
 
 
-def build(kind: str, **args) -> Mesh:
+def build(kind: str, **args: Any) -> Mesh:
     """Make a mesh from a name and keyword arguments, as requests spell them.
 
     Requests and preset files are untrusted text, so every failure is a
@@ -177,7 +178,7 @@ def _parameters(kind: str) -> tuple[inspect.Parameter, ...]:
     return tuple(inspect.signature(factory).parameters.values()) if factory else ()
 
 
-def arguments(kind: str, args: dict) -> dict:
+def arguments(kind: str, args: dict[str, Any]) -> dict[str, Any]:
     """``args`` with the generator's defaults filled in, as ``build`` would call it (empty
     for a kind that is not a generator here, such as a user's mesh file)."""
     return {p.name: args.get(p.name, p.default) for p in _parameters(kind)

@@ -57,7 +57,7 @@ def median_cut(radiance: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray
         return float(s)
 
     regions = [(-total(0, height, 0, width), 0, height, 0, width)]
-    done = []
+    done: list[tuple[int, int, int, int]] = []
     while regions and len(regions) + len(done) < count:
         _, r0, r1, c0, c1 = heapq.heappop(regions)
         # Angular extent: a column spans less angle near the poles.

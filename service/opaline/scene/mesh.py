@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,7 +75,8 @@ class Mesh:
         return np.concatenate([self.positions, self.normals, self.tangents, self.uvs], axis=1)
 
 
-def make_mesh(positions, normals, tangents, uvs, indices) -> Mesh:
+def make_mesh(positions: npt.ArrayLike, normals: npt.ArrayLike, tangents: npt.ArrayLike,
+              uvs: npt.ArrayLike, indices: npt.ArrayLike) -> Mesh:
     """Normalise in float64 before rounding, so float32 vectors are unit to ~1e-7."""
     normals = unit(normals)
     tangents = unit(tangents)
@@ -87,9 +89,10 @@ def make_mesh(positions, normals, tangents, uvs, indices) -> Mesh:
     )
 
 
-def unit(v: np.ndarray) -> np.ndarray:
-    v = np.asarray(v, dtype=np.float64)
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+def unit(v: npt.ArrayLike) -> np.ndarray:
+    vectors = np.asarray(v, dtype=np.float64)
+    out: np.ndarray = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+    return out
 
 
 def grid_indices(rows: int, cols: int) -> np.ndarray:

@@ -17,16 +17,34 @@ from __future__ import annotations
 import io
 import re
 from collections import OrderedDict
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
 
 from opaline.scene import tangents as tangent_fields
 from opaline.scene.mesh import Mesh, make_mesh
 
+if TYPE_CHECKING:
+    import trimesh
+
 FORMATS = ("glb", "gltf", "obj", "ply", "stl")
 DEFAULT_MAX_TRIANGLES = 2_000_000
 CACHED_MESHES = 4  # loaded meshes a worker keeps; the GPU copies have their own LRU
+
+
+class MeshSummary(TypedDict):
+    """What a check of an upload answers (as JSON): the file as the renderer reads it."""
+
+    format: str
+    triangles: int
+    vertices: int
+    uvs: bool
+    tangents: str
+    bounds: list[list[float]]  # [min xyz, max xyz] of the vertices the triangles use
+
+
 OBJ_LINE = re.compile(rb"^[ \t]*(v|vt|vn|f|o|g|s|mtllib|usemtl)[ \t]", re.MULTILINE)
 
 
@@ -55,7 +73,7 @@ def sniff(data: bytes, suffix: str = "") -> str:
                     f"(the file starts with {data[:16]!r})")
 
 
-def _parse(data: bytes, fmt: str):
+def _parse(data: bytes, fmt: str) -> trimesh.Trimesh:
     import trimesh  # imported here: only render workers ever parse a mesh
 
     try:
@@ -72,7 +90,7 @@ def _parse(data: bytes, fmt: str):
     return loaded
 
 
-def _uvs(loaded, count: int) -> np.ndarray | None:
+def _uvs(loaded: trimesh.Trimesh, count: int) -> np.ndarray | None:
     uv = getattr(loaded.visual, "uv", None) if getattr(loaded.visual, "kind", None) else None
     if uv is None:
         return None
@@ -82,8 +100,9 @@ def _uvs(loaded, count: int) -> np.ndarray | None:
     return uv
 
 
-def parse_mesh(data: bytes, suffix: str = "", field: str = "auto", axis=(0.0, 1.0, 0.0),
-               max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, dict]:
+def parse_mesh(data: bytes, suffix: str = "", field: str = "auto",
+               axis: Sequence[float] = (0.0, 1.0, 0.0),
+               max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
     """A renderable ``Mesh`` and a summary (format, counts, bounds, tangent field used)."""
     if not data:
         raise MeshError("empty file: expected a glTF/GLB, OBJ, PLY or STL mesh")
@@ -115,7 +134,7 @@ def parse_mesh(data: bytes, suffix: str = "", field: str = "auto", axis=(0.0, 1.
     lo, hi = used.min(axis=0), used.max(axis=0)
     mesh = make_mesh(positions, normals, tangents,
                      uvs if uvs is not None else np.zeros((len(positions), 2)), faces)
-    summary = {"format": fmt, "triangles": len(faces), "vertices": len(positions),
+    summary: MeshSummary = {"format": fmt, "triangles": len(faces), "vertices": len(positions),
                "uvs": uvs is not None, "tangents": used_field,
                "bounds": [lo.tolist(), hi.tolist()]}
     return mesh, summary
@@ -132,14 +151,18 @@ def _vertex_normals(positions: np.ndarray, faces: np.ndarray, areas: np.ndarray)
     bad = length < 1e-30  # unused vertices and cancelling fans: any unit vector will do
     summed[bad] = (0.0, 1.0, 0.0)
     length[bad] = 1.0
-    return summed / length[:, None]
+    unit: np.ndarray = summed / length[:, None]
+    return unit
 
 
-_loaded: OrderedDict[tuple, tuple[Mesh, dict]] = OrderedDict()
+# (path, size, mtime, field, axis, max_triangles) -> parse_mesh's answer
+_loaded: OrderedDict[tuple[str, int, int, str, tuple[float, ...], int],
+                    tuple[Mesh, MeshSummary]] = OrderedDict()
 
 
-def load_mesh_file(path: str | Path, field: str = "auto", axis=(0.0, 1.0, 0.0),
-                   max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, dict]:
+def load_mesh_file(path: str | Path, field: str = "auto",
+                   axis: Sequence[float] = (0.0, 1.0, 0.0),
+                   max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
     """``parse_mesh`` of a file, the last few kept (keyed by path, size and mtime)."""
     path = Path(path)
     try:
@@ -159,7 +182,8 @@ def load_mesh_file(path: str | Path, field: str = "auto", axis=(0.0, 1.0, 0.0),
 
 
 def mesh_file(path: str, digest: str = "", tangent_field: str = "auto",
-              tangent_axis=(0.0, 1.0, 0.0), max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
+              tangent_axis: Sequence[float] = (0.0, 1.0, 0.0),
+              max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
     """The geometry generator ``file``: ``digest`` is unused here but names the content in
     the preset's scene key, so a changed file never draws from a stale GPU copy."""
     return load_mesh_file(path, tangent_field, tuple(tangent_axis), max_triangles)[0]

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -175,11 +176,11 @@ def _decode(rgb: np.ndarray, full_scale: float) -> np.ndarray:
     """
     n = 2.0 * np.asarray(rgb, dtype=np.float64) / full_scale - 1.0
     length = np.linalg.norm(n, axis=-1, keepdims=True)
-    n = np.divide(n, length, out=np.zeros_like(n), where=length > 0.0)
-    return n.astype(np.float32)
+    unit: np.ndarray = np.divide(n, length, out=np.zeros_like(n), where=length > 0.0)
+    return unit.astype(np.float32)
 
 
-def from_image(path) -> np.ndarray:
+def from_image(path: str | os.PathLike[str]) -> np.ndarray:
     """A normal map from an RGB image file (anything Pillow opens).
 
     8-bit texels are quantised, so ``2c/255 - 1`` is only nearly unit length:
@@ -194,7 +195,7 @@ def from_image(path) -> np.ndarray:
     return _decode(rgb, 255.0)
 
 
-def _file(path: str | os.PathLike) -> np.ndarray:
+def _file(path: str | os.PathLike[str]) -> np.ndarray:
     """``from_image`` for requests: a path only, and unreadable files are a ``ValueError``."""
     if not isinstance(path, str | os.PathLike):
         raise ValueError(f"argument 'path' must be a file path, got {path!r}")
@@ -216,7 +217,7 @@ KINDS: dict[str, Callable[..., np.ndarray | None]] = {
 }
 
 
-def build(kind: str, **args) -> np.ndarray | None:
+def build(kind: str, **args: Any) -> np.ndarray | None:
     """Make a normal map from a name and keyword arguments, as requests spell them.
 
     ``"none"`` gives ``None`` (no map). Like ``geometry.build``, every failure

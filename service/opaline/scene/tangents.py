@@ -16,6 +16,7 @@ fallback keeps it defined.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 FIELDS = ("auto", "uv", "concentric", "projected")
 EPS = 1e-12
@@ -30,7 +31,7 @@ def _unit_rows(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return out, ok
 
 
-def project(normals: np.ndarray, direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def project(normals: np.ndarray, direction: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """``direction`` minus its normal component, unit; and where that was possible."""
     d = np.broadcast_to(np.asarray(direction, dtype=np.float64), normals.shape)
     return _unit_rows(d - normals * np.sum(normals * d, axis=1, keepdims=True))
@@ -42,13 +43,14 @@ def any_perpendicular(normals: np.ndarray) -> np.ndarray:
     return project(normals, axis)[0]
 
 
-def projected(normals: np.ndarray, direction) -> np.ndarray:
+def projected(normals: np.ndarray, direction: npt.ArrayLike) -> np.ndarray:
     t, ok = project(normals, direction)
     t[~ok] = any_perpendicular(normals[~ok])
     return t
 
 
-def concentric(positions: np.ndarray, normals: np.ndarray, axis, centre) -> np.ndarray:
+def concentric(positions: np.ndarray, normals: np.ndarray, axis: npt.ArrayLike,
+               centre: npt.ArrayLike) -> np.ndarray:
     """Circles about the line through ``centre`` along ``axis``, projected onto each surface."""
     axis = np.asarray(axis, dtype=np.float64)
     around = np.cross(axis, positions - np.asarray(centre, dtype=np.float64))
@@ -83,7 +85,8 @@ def from_uvs(positions: np.ndarray, normals: np.ndarray, uvs: np.ndarray,
 
 
 def tangent_frame(positions: np.ndarray, normals: np.ndarray, uvs: np.ndarray | None,
-                  faces: np.ndarray, field: str = "auto", axis=(0.0, 1.0, 0.0)
+                  faces: np.ndarray, field: str = "auto",
+                  axis: npt.ArrayLike = (0.0, 1.0, 0.0)
                   ) -> tuple[np.ndarray, str]:
     """Unit tangents (float64) for every vertex, and the field actually used.
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -31,7 +32,8 @@ def _grid(resolution: int) -> tuple[np.ndarray, np.ndarray]:
     return u, 1.0 - y  # v = 1 on row 0
 
 
-def _fourier_noise(rng, u, v, octaves: int, base: int) -> np.ndarray:
+def _fourier_noise(rng: np.random.Generator, u: np.ndarray, v: np.ndarray, octaves: int,
+                   base: int) -> np.ndarray:
     """Σ over octaves of random integer-frequency waves: tiles on the unit torus."""
     total = np.zeros_like(u)
     for octave in range(octaves):
@@ -47,7 +49,8 @@ def _fourier_noise(rng, u, v, octaves: int, base: int) -> np.ndarray:
 
 def _normalise(x: np.ndarray) -> np.ndarray:
     lo, hi = float(x.min()), float(x.max())
-    return ((x - lo) / max(hi - lo, 1e-12)).astype(np.float32)
+    scaled: np.ndarray = (x - lo) / max(hi - lo, 1e-12)
+    return scaled.astype(np.float32)
 
 
 def swirl(
@@ -105,7 +108,7 @@ def platelets(resolution: int = 512, seed: int = 1, cells: int = 90, spread: flo
     return value[owner].astype(np.float32)
 
 
-def _file(path: str | os.PathLike) -> np.ndarray:
+def _file(path: str | os.PathLike[str]) -> np.ndarray:
     if not isinstance(path, str | os.PathLike):
         raise ValueError(f"argument 'path' must be a file path, got {path!r}")
     from PIL import Image  # only image files need Pillow: a cold render skips its import
@@ -115,7 +118,8 @@ def _file(path: str | os.PathLike) -> np.ndarray:
             grey = np.asarray(image.convert("F"), dtype=np.float32)
     except OSError as error:
         raise ValueError(f"argument 'path': cannot read {str(path)!r}: {error}") from None
-    return np.clip(grey / 255.0, 0.0, 1.0)
+    field: np.ndarray = np.clip(grey / 255.0, 0.0, 1.0)
+    return field
 
 
 KINDS: dict[str, Callable[..., np.ndarray]] = {
@@ -126,6 +130,6 @@ KINDS: dict[str, Callable[..., np.ndarray]] = {
 }
 
 
-def build(kind: str, **args) -> np.ndarray:
+def build(kind: str, **args: Any) -> np.ndarray:
     """A thickness field from a name and keyword arguments; failures are ValueErrors."""
     return generators.call("thickness field", KINDS, kind, args)

@@ -6,6 +6,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from opaline.scene import generators
 from opaline.scene.mesh import Mesh, grid_indices, make_mesh
@@ -24,7 +25,7 @@ DEFAULT_WAVES: tuple[tuple[float, float, float, float], ...] = (
 )
 
 
-def check_waves(waves) -> np.ndarray:
+def check_waves(waves: object) -> np.ndarray:
     """(K, 4) float64 rows of amplitude, wavelength, direction (deg), phase."""
     if isinstance(waves, str | bytes) or not isinstance(waves, Sequence | np.ndarray):
         raise ValueError(f"argument 'waves' must be a list of 4-tuples, got {waves!r}")
@@ -38,7 +39,9 @@ def check_waves(waves) -> np.ndarray:
     return np.array(rows, dtype=np.float64).reshape(-1, 4)
 
 
-def wave_height(x, z, waves=DEFAULT_WAVES):
+def wave_height(
+    x: npt.ArrayLike, z: npt.ArrayLike, waves: object = DEFAULT_WAVES
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Height and its gradient ``(h, dh/dx, dh/dz)`` of the wavy surface.
 
     Public so that tests and other code (e.g. a reference ray caster) can use
@@ -74,12 +77,12 @@ def wavy_surface(
     """
     size = generators.positive("size", size)
     resolution = generators.integer("resolution", resolution, *RESOLUTION)
-    waves = check_waves(waves)
+    rows = check_waves(waves)
 
     s = np.linspace(-0.5 * size, 0.5 * size, resolution)
-    z, x = np.meshgrid(s, s, indexing="ij")  # row i = z, column j = x
-    x, z = x.ravel(), z.ravel()
-    h, hx, hz = wave_height(x, z, waves)
+    zz, xx = np.meshgrid(s, s, indexing="ij")  # row i = z, column j = x
+    x, z = xx.ravel(), zz.ravel()
+    h, hx, hz = wave_height(x, z, rows)
 
     positions = np.stack([x, h, z], 1)
     normals = np.stack([-hx, np.ones_like(x), -hz], 1)

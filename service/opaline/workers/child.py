@@ -88,7 +88,7 @@ def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None
 
 
 def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
-    from opaline.gl.renderer import Cancelled
+    from opaline.gl.buffers import Cancelled
     from opaline.gl.shaders import ShaderError
     from opaline.scene.environments import EnvironmentMapError
     from opaline.scene.meshfile import MeshError

@@ -17,7 +17,8 @@ class RendererFactory:
     environments_dir: Path | None = None  # the user's environment maps (settings)
 
     def __call__(self) -> Any:
-        from opaline.gl.renderer import RenderBudgets, Renderer
+        from opaline.gl.buffers import RenderBudgets
+        from opaline.gl.renderer import Renderer
 
         budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
                                 target_bytes=self.target_bytes)

@@ -23,6 +23,6 @@ class Job:
     label: str
     deadline: float
     predicted: float
-    future: Future = field(default_factory=Future)
+    future: Future[bytes] = field(default_factory=Future)
     waiters: int = 1
     seconds: float = 0.0  # the worker's time for it, once done

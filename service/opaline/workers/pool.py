@@ -56,7 +56,7 @@ class WorkerPool:
         self.cost = CostModel()
         self.counters: Counter[str] = Counter()
         self.stopping = True
-        self.warming: list[Future] = []
+        self.warming: list[Future[bytes]] = []
         self.slots: list[Slot] = []
         self._queue: deque[Job] = deque()
         self._inflight: dict[str, Job] = {}
@@ -79,7 +79,8 @@ class WorkerPool:
             log.error("no render worker has a GL context: %s",
                       "; ".join(s.error or s.state for s in self.slots))
             return
-        tasks = [self.warmup, CalibrateTask() if self.calibrate else None]
+        # Task declares label settable, a frozen dataclass's is read-only: fix in workers/tasks.py.
+        tasks: list[Task | None] = [self.warmup, CalibrateTask() if self.calibrate else None]  # type: ignore[list-item]
         with self._cond:  # first in the queue, never expiring, counted in the backlog
             for task in filter(None, tasks):
                 job = Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf,
@@ -206,8 +207,7 @@ class WorkerPool:
     def fail(self, job: Job, exc: Exception) -> None:
         self._settle(job, error=exc)
 
-    def _settle(self, job: Job, result: bytes | None = None,
-                error: Exception | None = None) -> None:
+    def _settle(self, job: Job, result: bytes = b"", error: Exception | None = None) -> None:
         with self._cond:
             if self._inflight.get(job.key) is job:
                 del self._inflight[job.key]

@@ -110,7 +110,9 @@ class Slot:
         process.start()
         kid.close()
         self.process, self.conn, self.renders = process, parent, 0
-        message = parent.recv() if parent.poll(pool.start_timeout_s) else ("failed", "no answer")
+        # ("ready", the context's description) or ("failed", why)
+        message: tuple[str, Any] = (parent.recv() if parent.poll(pool.start_timeout_s)
+                                    else ("failed", "no answer"))
         if message[0] != "ready":
             self.error = f"no GL context: {message[1]}"
             log.error("%s: %s", self.name, self.error)
@@ -182,7 +184,8 @@ class Slot:
                     f"the render ran past the {self.pool.render_timeout_s:g} s limit"))
                 return None
         try:
-            return self.conn.recv()
+            reply: child.Reply = self.conn.recv()
+            return reply
         except (EOFError, OSError):
             self.replace("died")
             self.pool.fail(job, Unavailable("the render worker died; try again"))
