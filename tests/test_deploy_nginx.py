@@ -21,9 +21,8 @@ import pytest
 
 from opaline.batch.run import Options, run_batch
 from opaline.model.params import RenderRequest
-from opaline.model.presets import get_preset
-from opaline.model.request import resolve
-from opaline.server.canonical import canonical_job, canonical_url
+from opaline.pipeline.limits import Limits
+from opaline.pipeline.prepare import Context, prepare
 from opaline.server.localproxy import LocalProxy, nginx_binary
 from opaline.server.localserver import LocalServer
 
@@ -35,9 +34,7 @@ PRESET = "cd-rom"  # the warm-up renders "sphere": counting cd-rom renders count
 def url(**fields) -> str:
     """The canonical URL, as a client learns it from Content-Location."""
     request = RenderRequest(**{"preset": PRESET, "quality": "draft", **fields})
-    preset = get_preset(PRESET)
-    job, query = canonical_job(resolve(request, preset), preset)
-    return canonical_url(query, job.cache_key(preset.scene_key()))
+    return prepare(request, Context(Limits(cost_budget=None), lambda r, p: p)).url()
 
 
 def renders(replica: LocalServer) -> float:
