@@ -33,7 +33,9 @@ def error(response, status: int, reason: str) -> list[str]:
     """The lines of an error answer, after checking the one shape every error has."""
     assert response.status_code == status, response.text
     body = response.json()
-    assert body["error"] == reason and set(body) == {"error", "detail"}, body
+    # A 422 also names the field of each problem about one (the page routes errors by it).
+    shape = {"error", "detail", "fields"} if status == 422 else {"error", "detail"}
+    assert body["error"] == reason and set(body) == shape, body
     assert body["detail"] and all(isinstance(line, str) for line in body["detail"]), body
     return body["detail"]
 
