@@ -10,10 +10,10 @@ import pytest
 
 from opaline.batch.plan import Task
 from opaline.batch.pool import GLProcesses, HttpThreads, start_pool
+from opaline.local.context import local_context
 from opaline.model.materials import Item
 from opaline.model.params import RenderRequest
-from opaline.model.presets import get_preset
-from opaline.model.request import resolve
+from opaline.pipeline.prepare import prepare
 from opaline.workers.slot import SPAWN
 
 
@@ -45,7 +45,7 @@ def test_a_server_gets_http_threads_whatever_the_job_count():
 def test_abort_ends_worker_processes_mid_render(backend):
     """abort() terminates the processes, the one busy with a long render included."""
     request = RenderRequest(preset="cd-rom", width=2048, height=2048, samples=256)
-    task = Task(Item("heavy", "heavy", request), job=resolve(request, get_preset("cd-rom")))
+    task = Task(Item("heavy", "heavy", request), prepared=prepare(request, local_context(None)))
     task.key = "heavy"
     pool = GLProcesses(2, backend)
     pids = [w["pid"] for w in pool.pool.status()]
