@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_BACKDROP
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -39,6 +39,9 @@ void main() {
 
 #ifdef FRAGMENT_SHADER
 #include "lib/reflectance.glsl"
+#ifdef ENVIRONMENT_MAP
+#include "lib/environment_light.glsl"
+#endif
 
 in vec3 v_world;
 in vec3 v_object;
@@ -48,12 +51,14 @@ in vec2 v_uv;
 
 uniform vec3 u_eye;
 uniform mat4 u_model;
+#ifndef ENVIRONMENT_MAP
 // xyz: position (w = 1, point light) or direction toward the light (w = 0).
 uniform vec4 u_light_position[LIGHT_COUNT];
 // Irradiance: at unit distance for point lights (falls off as 1/d²).
 uniform vec3 u_light_irradiance[LIGHT_COUNT];
 #ifdef DIFFUSE
 uniform vec3 u_ambient;
+#endif
 #endif
 #ifdef DISPLAY
 // One sample straight into the 8-bit target (draft): encoded here as resolve.glsl
@@ -122,6 +127,13 @@ void main() {
     vec3 v = normalize(u_eye - v_world);
 
     vec3 radiance = vec3(0.0);
+#ifdef ENVIRONMENT_MAP
+    // The map is the whole light: its irradiance replaces the preset's ambient term.
+    radiance = environment_specular(frame, v, film_nm);
+#ifdef DIFFUSE
+    radiance += environment_irradiance(vec3(frame[2])) * u_kd * u_albedo / PI;
+#endif
+#else
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec4 light = u_light_position[i];
         vec3 to_light = light.xyz - light.w * v_world;
@@ -133,12 +145,19 @@ void main() {
 #ifdef DIFFUSE
     radiance += u_ambient * u_kd * u_albedo;
 #endif
+#endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
     // A free, lossless film transmits what it does not reflect: the backdrop seen
     // through both walls, each met at the view's angle to the surface (the back
     // wall's own thickness is not known: this one's is used).
     vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm(film_nm));
-    radiance += u_backdrop * through * through;
+#ifdef ENV_BACKDROP
+    // The environment behind, straight through the film, where it is the background.
+    vec3 behind = env_lookup(env_to_map(-v), 0.0);
+#else
+    vec3 behind = u_backdrop;
+#endif
+    radiance += behind * through * through;
 #endif
 #ifdef DISPLAY
     frag_color = vec4(srgb_encode(tonemap(radiance * u_exposure)), 1.0);

@@ -15,13 +15,13 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from opaline.gl import uniforms
+from opaline.gl import texture_units, uniforms
 from opaline.gl.shaders import ProgramCache
+from opaline.model import irradiance
 from opaline.model.request import Job
 from opaline.scene.environments import resolve_map
 
 KEPT = 4
-ENVIRONMENT_UNIT = 2  # 0: the accumulate pass's source, 1: the normal map
 
 
 class Backgrounds:
@@ -31,6 +31,7 @@ class Backgrounds:
         self.fullscreen = fullscreen
         self.environments_dir = environments_dir
         self._maps: OrderedDict[str, moderngl.Texture] = OrderedDict()
+        self._irradiance: dict[str, np.ndarray] = {}
 
     def texture(self, name: str) -> moderngl.Texture:
         found = self._maps.get(name)
@@ -40,13 +41,23 @@ class Backgrounds:
             # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
             data = np.ascontiguousarray(radiance[::-1], dtype="f4")
             found = self.ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
-            found.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            # The mip chain is what environment light reads (filtered importance sampling).
+            found.build_mipmaps()
+            found.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             found.repeat_x, found.repeat_y = True, False
             self._maps[name] = found
+            self._irradiance[name] = irradiance.coefficients(radiance)
             while len(self._maps) > KEPT:
-                self._maps.popitem(last=False)[1].release()
+                forgotten, texture = self._maps.popitem(last=False)
+                texture.release()
+                self._irradiance.pop(forgotten, None)
         self._maps.move_to_end(name)
         return found
+
+    def irradiance(self, name: str) -> np.ndarray:
+        """The map's irradiance coefficients (model/irradiance.py), made with its texture."""
+        self.texture(name)
+        return self._irradiance[name]
 
     def prepare(self, programs: ProgramCache, job: Job, view_proj: np.ndarray,
                 size: tuple[int, int]) -> Callable[[tuple[float, float]], None] | None:
@@ -57,13 +68,13 @@ class Backgrounds:
         texture = self.texture(job.environment)
         intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
         uniforms.apply(program, {
-            "u_environment": ENVIRONMENT_UNIT, "u_size": (float(size[0]), float(size[1])),
+            "u_environment": texture_units.ENVIRONMENT, "u_size": (float(size[0]), float(size[1])),
             "u_inv_view_proj": np.linalg.inv(view_proj).astype("f4"),
             "u_rotation": math.radians(job.environment_rotation or 0.0),
             "u_intensity": intensity})
 
         def draw(jitter: tuple[float, float]) -> None:
-            texture.use(location=ENVIRONMENT_UNIT)
+            texture.use(location=texture_units.ENVIRONMENT)
             program["u_jitter"].value = jitter
             self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
             self.fullscreen(program)
@@ -74,3 +85,4 @@ class Backgrounds:
         for texture in self._maps.values():
             texture.release()
         self._maps.clear()
+        self._irradiance.clear()

@@ -6,8 +6,6 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-THICKNESS_UNIT = 2
-
 
 def thickness_texture(ctx: moderngl.Context, field) -> moderngl.Texture | None:
     """A thickness field as a tiling, mipmapped one-channel float texture."""

@@ -79,9 +79,10 @@ class Renderer:
         return material_program.surface_defines(job, preset)
 
     def render(self, job: Job, preset: Preset | None = None, all_features: bool = False,
-               should_stop: Callable[[], bool] | None = None) -> Frame:
+               should_stop: Callable[[], bool] | None = None, brute: bool = False) -> Frame:
         """Draw a job. ``all_features`` compiles every optional feature in (with neutral
-        values) instead of the scene's own variant: the benchmark's baseline.
+        values) instead of the scene's own variant: the benchmark's baseline. ``brute``
+        reads an environment map unfiltered: the accuracy benchmark's converged reference.
         ``should_stop`` is asked between samples; when it says so, ``Cancelled`` is raised."""
         self.gl.make_current()
         preset = scene_for_size(preset or get_preset(job.preset), job.width, job.height)
@@ -96,11 +97,12 @@ class Renderer:
         if (samples.passes == samples.samples == 1 and job.format not in ("npy", "png16")
                 and not job.environment_background):
             # One 8-bit sample: drawn and encoded in one pass, no resolve (rows bottom-up).
-            plan = DrawPlan(samples, display=True, forced=forced)
+            plan = DrawPlan(samples, display=True, forced=forced, brute=brute)
             self.surface.draw(job, preset, drawn, plan, should_stop)
             pixels = read_bytes(drawn.direct_fbo, size, channels)[::-1]
             return Frame(linear=None, display=None, pixels=np.ascontiguousarray(pixels))
-        self.surface.draw(job, preset, drawn, DrawPlan(samples, forced=forced), should_stop)
+        self.surface.draw(job, preset, drawn, DrawPlan(samples, forced=forced, brute=brute),
+                          should_stop)
         # One pass is left in the sample target; more are summed in the accumulation target.
         if samples.passes == 1:
             fbo, source = drawn.sample_fbo, drawn.sample_tex

@@ -24,6 +24,7 @@ log = logging.getLogger(__name__)
 
 INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 DECLARED = re.compile(r"^//!\s*defines:(.*)$")
+BRANCH = re.compile(r"^\s*#\s*(?:else|elif|endif)\b")
 
 Defines = Mapping[str, int | bool]
 
@@ -61,6 +62,10 @@ def expand(name: str, files: list[str], stack: tuple[str, ...] = ()) -> list[str
             out.append(f"#line {number + 1} {index}")
         else:
             out.append(line)
+            if BRANCH.match(line):
+                # The #line after an include in a skipped branch is skipped with it:
+                # each branch's end puts the numbering back.
+                out.append(f"#line {number + 1} {index}")
     return out
 
 

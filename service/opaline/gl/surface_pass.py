@@ -15,7 +15,15 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from opaline.gl import heightfield, material_program, passes, physical, uniforms
+from opaline.gl import (
+    environment_light,
+    heightfield,
+    material_program,
+    passes,
+    physical,
+    texture_units,
+    uniforms,
+)
 from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import Cancelled, SceneGPU, Targets
 from opaline.gl.lighting import light_uniforms
@@ -26,7 +34,6 @@ from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.model.spectrum import wavelength_shift
 
-NORMAL_MAP_UNIT = 1
 # The benchmark's baseline: every optional feature compiled in, with neutral values.
 # AA stays as the job asks: it is a quality choice, not a scene feature.
 ALL_FEATURES = ("DIFFUSE", "FRESNEL", "NORMAL_MAP")
@@ -36,11 +43,13 @@ ALL_FEATURES = ("DIFFUSE", "FRESNEL", "NORMAL_MAP")
 class DrawPlan:
     """``display``: one sample into the 8-bit target, display-encoded by the surface (no
     resolve); else linear samples into the float sample target. ``forced``: defines
-    compiled in whatever the scene uses (a missing normal map is then the flat one)."""
+    compiled in whatever the scene uses (a missing normal map is then the flat one).
+    ``brute``: environment light read at full resolution, never filtered."""
 
     samples: passes.SamplePlan
     display: bool = False
     forced: tuple[str, ...] = ()
+    brute: bool = False  # environment light at full resolution (the benchmark's reference)
 
     def target(self, targets: Targets) -> moderngl.Framebuffer:
         return targets.direct_fbo if self.display else targets.sample_fbo
@@ -96,8 +105,7 @@ class SurfacePass:
         if plan.display:
             defines.update(DISPLAY=True, **tonemap_defines(job))
         defines.update(dict.fromkeys(plan.forced, True))
-        lights = light_uniforms(job, preset, self.environments_dir)
-        defines["LIGHT_COUNT"] = len(lights["u_light_position"])
+        lights = self._light(job, preset, plan, defines)
         program = self.resources.programs.get("surface.glsl", defines)
         normal_matrix = np.linalg.inv(where.model[:3, :3]).T
         normal_matrix /= abs(np.linalg.det(normal_matrix)) ** (1.0 / 3.0)  # unit normals stay ~unit
@@ -117,6 +125,21 @@ class SurfacePass:
         uniforms.apply(program, values)
         return program
 
+    def _light(self, job: Job, preset: Preset, plan: DrawPlan,
+               defines: dict[str, int | bool]) -> dict[str, object]:
+        """The environment's map (and its defines), or the lights: the preset's, or the
+        environment's by median cut."""
+        if environment_light.reads_map(job):
+            assert job.environment is not None
+            defines.update(environment_light.defines(job, plan.samples, plan.brute))
+            texture = self.backgrounds.texture(job.environment)
+            texture.use(location=texture_units.ENVIRONMENT)
+            return environment_light.uniforms(job, plan.samples, texture,
+                                              self.backgrounds.irradiance(job.environment))
+        lights = light_uniforms(job, preset, self.environments_dir)
+        defines["LIGHT_COUNT"] = len(lights["u_light_position"])
+        return dict(lights)
+
     def _textures(self, job: Job, preset: Preset, scene: SceneGPU, plan: DrawPlan,
                   defines: dict[str, int | bool]) -> dict[str, object]:
         """Binds the variant's textures (once: the accumulate pass binds unit 0 only) and
@@ -126,15 +149,15 @@ class SurfacePass:
         if normal_map is None and "NORMAL_MAP" in plan.forced:
             normal_map = self.resources.flat_normal_map()
         if normal_map is not None:
-            values["u_normal_map"] = NORMAL_MAP_UNIT
+            values["u_normal_map"] = texture_units.NORMAL_MAP
             values["u_lod_bias"] = float(np.log2(plan.samples.factor))
-            normal_map.use(location=NORMAL_MAP_UNIT)
+            normal_map.use(location=texture_units.NORMAL_MAP)
         if defines.get("TRANSMISSION"):
             values["u_backdrop"] = physical.backdrop_radiance(
                 preset.background, job.tonemap, job.exposure)
         if defines.get("THICKNESS_MAP"):
-            values["u_thickness_map"] = physical.THICKNESS_UNIT
-            scene.thickness_map.use(location=physical.THICKNESS_UNIT)
+            values["u_thickness_map"] = texture_units.THICKNESS_MAP
+            scene.thickness_map.use(location=texture_units.THICKNESS_MAP)
         return values
 
     def _samples(self, job: Job, preset: Preset, targets: Targets, plan: DrawPlan,
@@ -168,6 +191,8 @@ class SurfacePass:
                 ctx.front_face = front_face
                 ctx.enable(moderngl.CULL_FACE)
             program["u_jitter"].value = jitter
+            if "u_env_pass" in program:
+                program["u_env_pass"].value = index
             vao.render(moderngl.TRIANGLES)
             ctx.disable(moderngl.CULL_FACE)
             if accumulate is not None:

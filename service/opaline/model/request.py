@@ -63,6 +63,7 @@ class Job:
     environment_rotation: float | None = None
     environment_intensity: float | None = None
     environment_lights: int | None = None
+    environment_samples: int | None = None
     environment_background: bool | None = None
 
     @property
@@ -73,6 +74,11 @@ class Job:
     def environment_count(self) -> int:
         """K: the lights an environment becomes, the job's own count or its tier's."""
         return self.environment_lights or self.tier.environment_lights
+
+    @property
+    def environment_sample_count(self) -> int:
+        """Lobe samples per pixel that read the environment map, the job's or its tier's."""
+        return self.environment_samples or self.tier.environment_samples
 
     @property
     def cost(self) -> int:

@@ -53,9 +53,15 @@ class SceneFields(BaseModel):
     environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(
         None, description="Multiplies the environment's radiance, 0 … 1000 (default 1).")
     environment_lights: Annotated[int, Field(ge=1, le=256)] | None = Field(
-        None, description="K: directional lights the environment becomes by median cut, "
-                          "1 … 256 (default: the tier's: draft 8, standard 16, high 32, "
+        None, description="K: light the scene with the environment as K directional lights "
+                          "by median cut instead of reading the map, 1 … 256 (a grating always "
+                          "does, by default with the tier's K: draft 8, standard 16, high 32, "
                           "reference 64).")
+    environment_samples: Annotated[int, Field(ge=1, le=4096)] | None = Field(
+        None, description="Directions drawn from the material's lobe per pixel to read the "
+                          "environment map, 1 … 4096 (default: the tier's: draft 2, standard "
+                          "4, high 64, reference 1024). Ignored where the environment becomes "
+                          "lights (environment_lights set, or a grating).")
     environment_background: bool | None = Field(
         None, description="Show the environment behind the object instead of the preset's "
                           "background (default false).")

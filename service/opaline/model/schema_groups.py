@@ -22,12 +22,12 @@ GROUPS: list[tuple[str, str, tuple[str, ...]]] = [
                                   "camera_elevation", "camera_distance")),
     ("environment", "Environment", ("environment", "environment_rotation",
                                     "environment_intensity", "environment_lights",
-                                    "environment_background")),
+                                    "environment_samples", "environment_background")),
     ("tier", "Quality tier overrides", ("samples", "wavelengths", "aa", "max_flip",
                                         "max_delta_e")),
 ]
 # What a tier sets and a request may override one by one.
-TIER = (*TIERS["draft"].render_settings(), "environment_lights")
+TIER = (*TIERS["draft"].render_settings(), "environment_lights", "environment_samples")
 
 
 def add_groups(schema: dict[str, Any]) -> None:

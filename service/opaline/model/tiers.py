@@ -40,6 +40,9 @@ class Tier:
     # 256², against K=256): each light costs about as much as the rest of the shading, and
     # ΔE00 mean falls from 2-4 (K=8) through 1-2.3 (16) and 0.6-1.6 (32) to 0.35-1 (64).
     environment_lights: int
+    # Directions per pixel drawn from the material's lobe to read the environment map
+    # (glsl/lib/environment_light.glsl), over all the tier's samples together.
+    environment_samples: int
     measured: Measured | None = None  # quality=auto only
 
     def render_settings(self) -> dict[str, int | str]:
@@ -49,7 +52,8 @@ class Tier:
     def describe(self) -> dict[str, int | str]:
         """The tier as GET /v1/tiers and ``--help`` show it."""
         return {"name": self.name, **self.render_settings(),
-                "environment_lights": self.environment_lights}
+                "environment_lights": self.environment_lights,
+                "environment_samples": self.environment_samples}
 
 
 TIERS: dict[str, Tier] = {tier.name: tier for tier in (
@@ -57,14 +61,18 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # presets the RGB model's own error outweighs one sample's aliasing, so the cheap tiers
     # buy wavelengths before samples: one sample of 8 wavelengths, band-limited, costs
     # little more than one RGB sample and has a third to half of its error.
-    Tier("draft", samples=1, wavelengths=8, aa="analytic", environment_lights=8),
+    Tier("draft", samples=1, wavelengths=8, aa="analytic",
+         environment_lights=8, environment_samples=2),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
-    Tier("standard", samples=1, wavelengths=16, aa="analytic", environment_lights=16),
+    Tier("standard", samples=1, wavelengths=16, aa="analytic",
+         environment_lights=16, environment_samples=4),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
-    Tier("high", samples=8, wavelengths=16, aa="none", environment_lights=32),
+    Tier("high", samples=8, wavelengths=16, aa="none",
+         environment_lights=32, environment_samples=64),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
-    Tier("reference", samples=64, wavelengths=32, aa="none", environment_lights=64),
+    Tier("reference", samples=64, wavelengths=32, aa="none",
+         environment_lights=64, environment_samples=1024),
 )}
 if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
     raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
@@ -77,4 +85,5 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
     like = next((tier for tier in TIERS.values()
                  if tier.samples >= samples and tier.wavelengths >= wavelengths),
                 TIERS["reference"])
-    return Tier("auto", samples, wavelengths, aa, like.environment_lights, measured)
+    return Tier("auto", samples, wavelengths, aa, like.environment_lights,
+                like.environment_samples, measured)

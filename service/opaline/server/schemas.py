@@ -51,4 +51,7 @@ class TierInfo(BaseModel):
     samples: int = Field(description="Samples per pixel.")
     wavelengths: int = Field(description="Wavelengths integrated (0: the paper's RGB model).")
     aa: str = Field(description="Anti-aliasing: 'analytic' or 'none'.")
-    environment_lights: int = Field(description="Directional lights an environment becomes.")
+    environment_lights: int = Field(description="Directional lights an environment becomes "
+                                                "where it is drawn as lights.")
+    environment_samples: int = Field(description="Lobe samples per pixel that read the "
+                                                 "environment map.")

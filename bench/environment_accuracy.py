@@ -1,0 +1,121 @@
+"""Environment light from the map, measured: each tier's error against a converged
+brute-force reference of the same integral, and its time.
+
+    OPALINE_ENVIRONMENTS_DIR=DIR python bench/environment_accuracy.py [--size 128]
+        [--environments studio pedestrian_overpass_1k.hdr] [--cases mirror glossy]
+
+The reference renders the material at the ``reference`` tier (64 samples, 32
+wavelengths) with the map read at full resolution for every sample (``brute``: no
+prefiltering) and ``--reference-samples`` lobe samples per pixel; it is converged when
+it agrees with a render of half as many samples (the ``converged`` column, FLIP). Each
+tier then renders as a user gets it (its samples, wavelengths, environment samples,
+filtered importance sampling) and is compared with the reference on display images
+(bench/metrics.py: FLIP, CIEDE2000). Median-cut lights at the tier's K are measured
+beside it, the method they replace. Prints the table, writes
+bench/results/environment_accuracy.{md,json}.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "service")]
+from metrics import all_metrics  # noqa: E402
+from opaline.local.pipeline import LocalRenderer  # noqa: E402
+from opaline.model.params import RenderRequest  # noqa: E402
+from report import save  # noqa: E402
+
+# Materials on the sphere preset, no diffuse: the specular integral is what is measured.
+CASES: dict[str, dict[str, Any]] = {
+    "mirror": dict(mdf="ashikhmin", ex=1e6, ey=1e6, theta1=0.0, theta2=0.0),
+    "glossy": dict(mdf="ashikhmin", ex=300.0, ey=300.0, theta1=0.0, theta2=0.0),
+    "glossy-aniso": dict(mdf="ashikhmin", ex=100.0, ey=1000.0, theta1=0.0, theta2=0.0),
+    "rotation": dict(mdf="ashikhmin", ex=100.0, ey=1000.0, theta1=0.5, theta2=1.0),
+    "thin-film": dict(iridescence="thin-film", ex=500.0, ey=500.0, film_ior=1.33,
+                      substrate_ior=1.0, film_thickness_min=250.0, film_thickness_max=650.0),
+    "multipeak": dict(),  # the sphere preset's own material
+}
+TIERS = ("draft", "standard", "high")
+
+
+def render(local: LocalRenderer, fields: dict[str, Any], brute: bool = False
+           ) -> tuple[np.ndarray, float]:
+    job = local.job(RenderRequest(**fields, format="png16"))
+    times = []
+    for _ in range(1 if brute else 2):
+        start = time.perf_counter()
+        frame = local.renderer.render(job, brute=brute)
+        times.append(time.perf_counter() - start)
+    assert frame.display is not None
+    return frame.display[..., :3], min(times)
+
+
+def measure(local: LocalRenderer, case: str, environment: str, size: int, samples: int
+            ) -> list[dict[str, Any]]:
+    base = dict(preset="sphere", width=size, height=size, environment=environment, kd=0.0,
+                environment_background=False, **CASES[case])
+    reference, ref_s = render(local, {**base, "quality": "reference",
+                                      "environment_samples": samples}, brute=True)
+    half, _ = render(local, {**base, "quality": "reference",
+                             "environment_samples": samples // 2}, brute=True)
+    converged = all_metrics(reference, half)["flip"]
+    rows = []
+    for tier in TIERS:
+        for method, extra in (("map", {}), ("lights", {"environment_lights": 0})):
+            fields = {**base, "quality": tier, **extra}
+            if method == "lights":
+                fields["environment_lights"] = local.job(
+                    RenderRequest(**{**base, "quality": tier})).tier.environment_lights
+            image, seconds = render(local, fields)
+            rows.append({"case": case, "environment": environment, "tier": tier,
+                         "method": method, "ms": seconds * 1e3, "ref_s": ref_s,
+                         "converged_flip": converged, **all_metrics(reference, image)})
+            print(json.dumps(rows[-1]), flush=True)
+    return rows
+
+
+def table(rows: list[dict[str, Any]], size: int, samples: int) -> str:
+    lines = [f"# Environment light against a brute-force reference, {size}²", "",
+             f"Reference: the reference tier, the map read unfiltered, {samples} lobe "
+             "samples per pixel; `converged` is its FLIP against half as many. Command: "
+             "`python bench/environment_accuracy.py`.", "",
+             "| case | environment | tier | method | ms | FLIP | ΔE00 mean | ΔE00 p95 | converged |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['environment']} | {r['tier']} | {r['method']} | "
+                     f"{r['ms']:.0f} | {r['flip']:.4f} | {r['de2000_mean']:.2f} | "
+                     f"{r['de2000_p95']:.2f} | {r['converged_flip']:.4f} |")
+    worst = {(t, m): max(r["flip"] for r in rows if r["tier"] == t and r["method"] == m)
+             for t in TIERS for m in ("map", "lights")}
+    lines += ["", "Worst FLIP over the cases: " + ", ".join(
+        f"{t} {m} {v:.3f}" for (t, m), v in worst.items())]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=128)
+    parser.add_argument("--environments", nargs="+", default=["studio"])
+    parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    parser.add_argument("--reference-samples", type=int, default=4096)
+    args = parser.parse_args()
+    rows: list[dict[str, Any]] = []
+    with LocalRenderer() as local:
+        for environment in args.environments:
+            for case in args.cases:
+                rows += measure(local, case, environment, args.size, args.reference_samples)
+    save("environment_accuracy", rows, table(rows, args.size, args.reference_samples))
+    print("median reference seconds", statistics.median(r["ref_s"] for r in rows))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,123 @@
+// Environment light read from its map, not from lights (docs/design.md §4.6).
+// Specular: filtered importance sampling (Křivánek & Colbert, GPU Gems 3 ch. 20). Each
+// pass draws ENV_SAMPLES directions from the material's own lobe (lib/lobe_sampling.glsl);
+// each sample reads the map's mip level whose texel covers the solid angle the sample
+// stands for, 1/(N·pdf), N the pixel's samples over all passes. Few samples then give a
+// smooth, slightly widened reflection instead of noise; as N grows the level falls to 0
+// and the estimate converges to the integral of the BRDF against the map. ENV_BRUTE
+// reads level 0 always: the brute-force reference the benchmark converges.
+// Diffuse: the map's irradiance in nine spherical harmonics (Ramamoorthi & Hanrahan
+// 2001), exact for a Lambertian term to within ~3 % of the map's irradiance.
+// Float64 twins: opaline/model/lobe_sampling.py, opaline/model/irradiance.py.
+#ifndef ENVIRONMENT_LIGHT_GLSL
+#define ENVIRONMENT_LIGHT_GLSL
+#include "lib/reflectance.glsl"
+#include "lib/lobe_sampling.glsl"
+
+uniform sampler2D u_env_map;  // linear radiance, equirectangular, v = 1 at the zenith
+uniform float u_env_rotation;  // radians the environment is turned about +y
+uniform float u_env_intensity;
+uniform vec2 u_env_size;  // level 0, texels
+uniform float u_env_max_lod;
+uniform int u_env_pass;  // this pass's index: passes continue one sequence
+uniform float u_env_total;  // the pixel's samples over all passes
+uniform vec2 u_env_lobe_rotation[3];  // (cos, sin) of 0, theta1, theta2: the lobes sampled
+uniform vec3 u_env_sh[9];  // irradiance coefficients, Â_l and Y_lm's constants folded in
+
+// Into the map's own frame (the environment turns, the object stays).
+vec3 env_to_map(vec3 d) {
+    float c = cos(u_env_rotation);
+    float s = sin(u_env_rotation);
+    return vec3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
+}
+
+vec3 env_lookup(vec3 m, float lod) {
+    float azimuth = atan(m.z, m.x);
+    float elevation = asin(clamp(m.y, -1.0, 1.0));
+    vec2 uv = vec2(fract(azimuth / TWO_PI), 0.5 + elevation / PI);
+    return textureLod(u_env_map, uv, lod).rgb * u_env_intensity;
+}
+
+// The level whose texel spans 1/(N·pdf): a level-0 texel spans (2π/W)(π/H)·cos(elevation).
+float env_lod(vec3 m, float pdf_l) {
+#ifdef ENV_BRUTE
+    return 0.0;
+#else
+    float texel = TWO_PI * PI / (u_env_size.x * u_env_size.y)
+                  * max(sqrt(max(1.0 - m.y * m.y, 0.0)), 0.5 / u_env_size.y);
+    float share = 1.0 / max(u_env_total * pdf_l, 1e-30);
+    // Colbert & Křivánek add 1 (a sample's footprint is wider than its share) for ~40
+    // samples; at the tiers' 2-64 a trilinear read of that level is wider than the lobe
+    // itself. Measured against the brute-force reference (bench/environment_accuracy.py),
+    // FLIP is least at -2 for every tier, map and lobe tried (docs/accuracy.md).
+    return clamp(0.5 * log2(share / texel) - 2.0, 0.0, u_env_max_lod);
+#endif
+}
+
+// Per pixel, a shift of the whole sequence (Cranley-Patterson) by interleaved gradient
+// noise (Jimenez 2014): neighbours' shifts differ as much as they can, so the few
+// samples' error is fine-grained, high-frequency grain rather than blotches.
+vec3 env_pixel_shift() {
+    vec2 p = floor(gl_FragCoord.xy);
+    float ign = fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715))));
+    return vec3(ign, fract(ign + 0.5 * fract(p.x * 0.5 + p.y * 0.25)), fract(ign * 7.0));
+}
+
+// Sample k of the pixel: the R2 sequence (Roberts 2018) and a third dimension for the lobe.
+vec3 env_sequence(int k, vec3 shift) {
+    float n = float(k) + 0.5;
+    return fract(shift + n * vec3(0.7548776662, 0.5698402910, 0.6180339887));
+}
+
+// A half vector from the lobe and the density of the whole mixture there.
+vec4 env_sample_half(vec3 u) {
+#if defined(MDF_MULTIPEAK)
+    return sample_projected_disc(u.xy);
+#elif defined(IRIDESCENCE_THIN_FILM)
+    return sample_ashikhmin(u.xy, u_ex, u_ey);
+#else
+    // Rotation colour: one of the three channels' lobes (each is eq. 1's lobe turned by
+    // -θc), chosen at random, weighted by the mixture's density (one-sample MIS).
+    int c = int(min(u.z * 3.0, 2.0));
+    vec4 s = sample_ashikhmin(u.xy, u_ex, u_ey);
+    vec2 cs = u_env_lobe_rotation[c];
+    vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
+    float pdf = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        pdf += mdf_ashikhmin(rotate_half(h.xy, u_env_lobe_rotation[i]), h.z, u_ex, u_ey);
+    }
+    return vec4(h, pdf / 3.0);
+#endif
+}
+
+vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
+    vec3 vl = vec3(transpose(frame) * real3(v));
+    vec3 shift = env_pixel_shift();
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < ENV_SAMPLES; ++i) {
+        vec4 s = env_sample_half(env_sequence(u_env_pass * ENV_SAMPLES + i, shift));
+        float vh = dot(vl, s.xyz);
+        vec3 ll = 2.0 * vh * s.xyz - vl;
+        if (vh <= 0.0 || ll.z <= 0.0 || s.w <= 0.0) {
+            continue;
+        }
+        // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
+        float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
+        vec3 l = vec3(frame * real3(ll));
+        vec3 f = specular(frame, l, v, film_nm) * ll.z;
+        vec3 m = env_to_map(l);
+        sum += env_lookup(m, env_lod(m, pdf_l)) * (f / pdf_l);
+    }
+    return sum / float(ENV_SAMPLES);
+}
+
+vec3 environment_irradiance(vec3 n) {
+    vec3 d = env_to_map(n);
+    vec3 e = u_env_sh[0] + u_env_sh[1] * d.y + u_env_sh[2] * d.z + u_env_sh[3] * d.x
+             + u_env_sh[4] * (d.x * d.y) + u_env_sh[5] * (d.y * d.z)
+             + u_env_sh[6] * (3.0 * d.z * d.z - 1.0) + u_env_sh[7] * (d.x * d.z)
+             + u_env_sh[8] * (d.x * d.x - d.y * d.y);
+    return max(e, vec3(0.0)) * u_env_intensity;
+}
+
+#endif
