@@ -2,7 +2,7 @@
 
 Every function takes two display images (sRGB-encoded, values in [0, 1],
 H×W×3 or H×W×4; alpha is ignored), the reference first. Shared by
-``bench/accuracy.py`` and ``tests/test_quality.py``.
+``bench/accuracy.py`` and ``tests/gl/test_quality.py``.
 """
 
 from __future__ import annotations

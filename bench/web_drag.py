@@ -6,7 +6,7 @@ Starts ``opaline serve`` (one worker) on loopback, opens the tuning page with
 the preview shown at 256 CSS px (so the drafts are 256² at devicePixelRatio 1),
 presses on it and moves the light in small steps every 16 ms, and counts the
 draft frames the page shows (``data-live-frames``). Writes
-bench/results/web_drag.json. tests/test_web.py uses ``drag_preview`` too.
+bench/results/web_drag.json. tests/web/test_web.py uses ``drag_preview`` too.
 """
 
 from __future__ import annotations

@@ -62,3 +62,17 @@ def broken_files() -> dict[str, bytes]:
 
 def load(data: bytes, fmt: str) -> trimesh.Trimesh:
     return trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh")
+
+
+def coverage_box(alpha: np.ndarray) -> tuple[int, int, int, int]:
+    rows, cols = np.nonzero(alpha > 0.5)
+    return rows.min(), rows.max(), cols.min(), cols.max()
+
+
+def assert_framed(alpha: np.ndarray) -> None:
+    """The object's bounding box is inside the image and covers a fair part of it."""
+    h, w = alpha.shape
+    top, bottom, left, right = coverage_box(alpha)
+    assert top > 0 and left > 0 and bottom < h - 1 and right < w - 1, (top, bottom, left, right)
+    assert (bottom - top + 1) * (right - left + 1) > 0.15 * h * w
+    assert max(bottom - top + 1, right - left + 1) > 0.6 * min(h, w)

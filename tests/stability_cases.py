@@ -1,4 +1,4 @@
-"""Inputs and checks for ``tests/test_stability.py`` (issue 4, docs/design.md §5 and §8).
+"""Inputs and checks for ``tests/gl/test_stability.py`` (issue 4, docs/design.md §5 and §8).
 
 - ``EXTREMES``: one material per end of every range of docs/design.md §5, each named
   (``ex=1e6``, ``theta1=-2pi``, ``mu_f=0`` ...);

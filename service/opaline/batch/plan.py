@@ -92,7 +92,8 @@ def up_to_date(task: Task) -> bool:
     if task.output is None or not task.output.is_file():
         return False
     try:
-        return json.loads(task.sidecar.read_text()).get("key") == task.key
+        recorded: object = json.loads(task.sidecar.read_text()).get("key")
+        return recorded == task.key
     except (OSError, ValueError, AttributeError):  # unreadable, not JSON, not a JSON object
         return False
 

@@ -56,7 +56,7 @@ class GLProcesses:
         assert task.prepared is not None and task.key is not None  # only planned tasks run
         outcome: Future[Outcome] = Future()
         try:
-            job = self.pool.submit(task.key, ImageTask(task.prepared))  # type: ignore[arg-type]
+            job = self.pool.submit(task.key, ImageTask(task.prepared))
         except Exception as exc:  # no worker has a context: the item fails with the reason
             outcome.set_result((None, 0.0, f"{type(exc).__name__}: {exc}"))
             return outcome

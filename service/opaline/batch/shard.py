@@ -94,14 +94,15 @@ def _shard_numbers(summaries: Sequence[dict[str, Any]]) -> list[int]:
     smaller batch."""
     if not summaries:
         raise ShardError("no summaries to merge")
-    found = [parse_shard(s["shard"]) if s.get("shard") else None for s in summaries]
-    if None in found:
+    given = [parse_shard(s["shard"]) if s.get("shard") else None for s in summaries]
+    found = [shard for shard in given if shard is not None]
+    if len(found) < len(given):
         raise ShardError("a summary is not from a sharded run (no \"shard\" in it)")
-    counts = {n for _, n in found}  # type: ignore[misc]
+    counts = {n for _, n in found}
     if len(counts) != 1:
         raise ShardError(f"summaries from different shard counts: {sorted(counts)}")
     total = counts.pop()
-    numbers = sorted(k for k, _ in found)  # type: ignore[misc]
+    numbers = sorted(k for k, _ in found)
     if numbers != list(range(1, total + 1)):
         missing = sorted(set(range(1, total + 1)) - set(numbers))
         repeated = sorted({k for k in numbers if numbers.count(k) > 1})

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import logging
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from opaline.cli.args import (
     CliError,
@@ -16,8 +17,11 @@ from opaline.cli.args import (
     write_output,
 )
 
+if TYPE_CHECKING:  # the command imports local.export only when it runs
+    from opaline.local.export import ExportKind
+
 log = logging.getLogger("opaline.cli")
-KINDS = {".glsl": "glsl", ".frag": "glsl", ".glb": "glb"}
+KINDS: dict[str, ExportKind] = {".glsl": "glsl", ".frag": "glsl", ".glb": "glb"}
 
 
 def cmd_export(args: argparse.Namespace) -> None:
@@ -27,7 +31,7 @@ def cmd_export(args: argparse.Namespace) -> None:
     kind = KINDS.get(Path(args.output).suffix.lower())
     if kind is None:
         raise CliError(f"-o {args.output}: the name must end in .glsl, .frag or .glb")
-    data = export_material(request, kind)  # type: ignore[arg-type]
+    data = export_material(request, kind)
     write_output(args.output, data)
     log.info("wrote %s (%d bytes)", args.output, len(data))
 

@@ -15,11 +15,17 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from opaline.model.auto_table import Difficulty, Measure, MeasuredMaterial, Picked, Table
 from opaline.model.params import Material
 from opaline.model.tiers import TIERS, Measured, Tier, auto_tier
+
+if TYPE_CHECKING:
+    from opaline.model.presets import Preset
 
 TABLE_PATH = Path(__file__).resolve().parent / "quality_table.json"
 TABLE_SIZE = 128  # the table's renders are TABLE_SIZE² pixels
@@ -34,7 +40,7 @@ MARGIN = 0.7
 # land on turns of π, which leave the pattern as it is), so a harder material measured
 # with them bounds nothing. A material judged on another one gets this many or more.
 MIN_WAVELENGTHS_JUDGED = 8
-MEASURES = ("rate", "turn", "span", "brightness")  # difficulty's numbers, each growing with it
+MEASURES: tuple[Measure, ...] = ("rate", "turn", "span", "brightness")
 TWO_PI = 2.0 * math.pi
 
 # Harder materials measured beside each preset's own ("base"): "fine" doubles the
@@ -56,7 +62,7 @@ def variant_material(material: Material, variant: str) -> Material:
     return material.model_copy(update=changes)
 
 
-def difficulty(material: Material, width: int, height: int, exposure: float) -> dict:
+def difficulty(material: Material, width: int, height: int, exposure: float) -> Difficulty:
     """What drives a render's error, each growing with it.
 
     turn: how fast the pattern changes as it rotates (mu_f·|√α − √β|, or |√ex − √ey|);
@@ -83,7 +89,7 @@ def difficulty(material: Material, width: int, height: int, exposure: float) -> 
             "size": min(width, height)}
 
 
-def at_most(easy: dict, hard: dict) -> bool:
+def at_most(easy: Difficulty, hard: Difficulty) -> bool:
     """Is ``easy`` no harder than ``hard`` in every respect (same MDF)?"""
     tol = 1e-9
     return easy["mdf"] == hard["mdf"] and all(
@@ -91,18 +97,19 @@ def at_most(easy: dict, hard: dict) -> bool:
 
 
 @cache
-def load_table(path: Path = TABLE_PATH) -> dict:
-    return json.loads(path.read_text())
+def load_table(path: Path = TABLE_PATH) -> Table:
+    table: Table = json.loads(path.read_text())
+    return table
 
 
-def preset_digest(preset) -> str:
+def preset_digest(preset: Preset) -> str:
     """Hash of what the table's numbers depend on in a preset: its scene and its defaults."""
     data = {"scene": preset.scene_key(), "defaults": preset.defaults.model_dump(mode="json")}
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 
 def pick(preset_name: str, material: Material, width: int, height: int, exposure: float,
-         max_flip: float | None, max_delta_e: float | None, table: dict | None = None) -> Tier:
+         max_flip: float | None, max_delta_e: float | None, table: Table | None = None) -> Tier:
     """The fastest measured setting meeting the targets on the measured materials that stand
     for ``material`` (judged_on; the point-wise worst among them), or the fallback tier's
     setting; as a tier of its own that says why."""
@@ -151,7 +158,8 @@ def pick(preset_name: str, material: Material, width: int, height: int, exposure
                               max_delta_e))
 
 
-def judged_on(measured: list[dict], material: Material, wanted: dict) -> tuple[list[dict], bool]:
+def judged_on(measured: list[MeasuredMaterial], material: Material, wanted: Difficulty
+              ) -> tuple[list[MeasuredMaterial], bool]:
     """The measured materials whose errors stand for ``material``'s, and whether it is one of
     them (the same material, at the table's size or larger).
 
@@ -161,7 +169,7 @@ def judged_on(measured: list[dict], material: Material, wanted: dict) -> tuple[l
     its own, provided its rate, turn and brightness lie within theirs.
     """
     # The same material (its measures at the table's own size), drawn at least that large.
-    own = {**wanted, "rate": wanted["rate"] * wanted["size"] / TABLE_SIZE}
+    own: Difficulty = {**wanted, "rate": wanted["rate"] * wanted["size"] / TABLE_SIZE}
     for m in measured:
         d = m["difficulty"]
         if (d["mdf"] == wanted["mdf"] and _close(m["theta"], (material.theta1, material.theta2))
@@ -179,11 +187,11 @@ def judged_on(measured: list[dict], material: Material, wanted: dict) -> tuple[l
     return (level, False) if inside else ([], False)
 
 
-def _close(a, b) -> bool:
+def _close(a: Sequence[float], b: Sequence[float]) -> bool:
     return all(abs(x - y) <= 1e-9 * max(1.0, abs(y)) for x, y in zip(a, b, strict=True))
 
 
-def auto_headers(job) -> dict[str, str]:
+def auto_headers(job: Picked) -> dict[str, str]:
     """Response headers saying what quality=auto picked; empty for other qualities.
 
     For the HTTP layer: ``response.headers.update(auto_headers(job))``."""
@@ -205,7 +213,7 @@ def auto_headers(job) -> dict[str, str]:
     return headers
 
 
-def describe(job) -> str:
+def describe(job: Picked) -> str:
     """One line for the CLI's verbose output."""
     headers = auto_headers(job)
     headers.pop("X-Opaline-Auto-Setting", None)  # the CLI line states the setting already

@@ -9,9 +9,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 from opaline.model.meshes import MESH_VIEW
-from opaline.model.presets import Camera, Light
+from opaline.model.presets import Camera, Light, Vec3
 
 
 def perspective(fov_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
@@ -25,7 +26,8 @@ def perspective(fov_deg: float, aspect: float, near: float, far: float) -> np.nd
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.sqrt(np.sum(v**2))
+    unit: np.ndarray = v / np.sqrt(np.sum(v**2))
+    return unit
 
 
 def look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -46,7 +48,9 @@ def view_projection(camera: Camera, aspect: float) -> np.ndarray:
     distance = float(np.linalg.norm(eye - target))
     near, far = max(distance * 0.02, 1e-3), distance * 10.0
     projection = perspective(camera.fov_deg, aspect, near, far)
-    return look_at(eye, target, np.asarray(camera.up, dtype=np.float64)) @ projection
+    view = look_at(eye, target, np.asarray(camera.up, dtype=np.float64))
+    view_proj: np.ndarray = view @ projection
+    return view_proj
 
 
 def _rotation(theta: float, axis: int) -> np.ndarray:
@@ -60,24 +64,27 @@ def _rotation(theta: float, axis: int) -> np.ndarray:
 
 def model_matrix(rotation_deg: tuple[float, float, float]) -> np.ndarray:
     rx, ry, rz = (math.radians(a) for a in rotation_deg)
-    return _rotation(rx, 0) @ _rotation(ry, 1) @ _rotation(rz, 2)
+    model: np.ndarray = _rotation(rx, 0) @ _rotation(ry, 1) @ _rotation(rz, 2)
+    return model
 
 
-def _centre(light: Light, target) -> np.ndarray | float:
+def _centre(light: Light, target: Vec3) -> np.ndarray | float:
     """What a light's position is taken around: the target for a point light; a directional
     light's "position" is already a direction, so the origin."""
     return np.asarray(target, dtype=np.float64) if light.type == "point" else 0.0
 
 
-def _key_offset(light: Light, target) -> np.ndarray:
+def _key_offset(light: Light, target: Vec3) -> np.ndarray:
     return np.asarray(light.position, dtype=np.float64) - _centre(light, target)
 
 
-def key_light_direction(lights: list[Light], target) -> dict[str, float] | None:
+def key_light_direction(lights: list[Light], target: Vec3) -> dict[str, float] | None:
     """Where the first light sits, in the degrees light_azimuth/light_elevation use."""
-    if not lights:
-        return None
-    offset = _key_offset(lights[0], target)
+    return _direction(lights[0], target) if lights else None
+
+
+def _direction(light: Light, target: Vec3) -> dict[str, float]:
+    offset = _key_offset(light, target)
     radius = float(np.linalg.norm(offset)) or 1.0
     return {
         "azimuth": math.degrees(math.atan2(offset[2], offset[0])),
@@ -97,7 +104,7 @@ def place_key_light(
     key = lights[0]
     offset = _key_offset(key, target)
     radius = float(np.linalg.norm(offset)) or 1.0
-    current = key_light_direction(lights, target)
+    current = _direction(key, target)
     az = math.radians(current["azimuth"] if azimuth_deg is None else azimuth_deg)
     el = math.radians(current["elevation"] if elevation_deg is None else elevation_deg)
     direction = np.array([math.cos(el) * math.cos(az), math.sin(el), math.cos(el) * math.sin(az)])
@@ -110,7 +117,8 @@ def place_key_light(
 FRAME_MARGIN = 1.08  # the bounding sphere fills the shorter side of the image, with a margin
 
 
-def orbit(target, azimuth_deg: float, elevation_deg: float, distance: float) -> tuple:
+def orbit(target: npt.ArrayLike, azimuth_deg: float, elevation_deg: float, distance: float
+          ) -> tuple[float, ...]:
     az, el = math.radians(azimuth_deg), math.radians(elevation_deg)
     direction = np.array([math.cos(el) * math.cos(az), math.sin(el), math.cos(el) * math.sin(az)])
     return tuple(float(x) for x in np.asarray(target, dtype=np.float64) + direction * distance)
@@ -123,7 +131,7 @@ def framing_distance(radius: float, fov_deg: float, aspect: float) -> float:
     return FRAME_MARGIN * radius / math.sin(half)
 
 
-def fit_matrix(sphere: tuple, target) -> np.ndarray:
+def fit_matrix(sphere: tuple[npt.ArrayLike, float], target: Vec3) -> np.ndarray:
     """Row-vector model matrix that moves a mesh's bounding sphere (centre, radius) onto a
     unit sphere at ``target``: a user's mesh then sits where the preset's lights and camera
     expect an object, whatever units it was modelled in (mm, m, or a 1e4-wide scan)."""

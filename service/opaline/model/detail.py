@@ -15,6 +15,8 @@ preset it rewrites, under the renderer's layer.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from opaline.model.presets import Generator, Preset
@@ -35,7 +37,7 @@ GENTLE_SLOPE = 0.2
 CELLS_PER_WAVE = 8
 
 
-def analytic_sheet(preset: Preset) -> tuple[dict, np.ndarray] | None:
+def analytic_sheet(preset: Preset) -> tuple[dict[str, Any], np.ndarray] | None:
     """The wavy sheet's arguments (defaults filled in) and its waves, if its slope is
     computed per fragment (gl/heightfield.py): at most ``MAX_WAVES`` waves."""
     if preset.geometry.kind != "wavy":

@@ -76,7 +76,7 @@ def wavelengths_schema(schema: dict[str, Any]) -> None:
         schema["not"] = {"enum": refused}
 
 
-class RenderFields(MaterialFields, SceneFields):  # type: ignore[misc,valid-type]  # generated
+class RenderFields(MaterialFields, SceneFields):
     """What a request (or a preset's defaults) may set besides the material."""
 
     width: Pixels | None = Field(None, description="Image width in pixels, 16 … 2048.")

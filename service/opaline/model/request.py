@@ -102,7 +102,7 @@ class Job:
         return content_key({"job": self.canonical(), "scene": scene_key})
 
 
-def content_key(payload: dict) -> str:
+def content_key(payload: dict[str, object]) -> str:
     """Hash of what an image depends on, with the shader sources and the version, so a
     changed shader or release never answers from an old image."""
 

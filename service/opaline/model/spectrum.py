@@ -58,7 +58,7 @@ XYZ_TO_SRGB = np.array([[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415],
 # its 1 nm table (Sprague), sampled at 0.1 nm and shipped with the package: linear
 # interpolation between those samples is within 1e-5 of colour-science's values, and a
 # render does not pay for importing colour-science and scipy (over a second cold).
-# Regenerate with tests/test_spectrum.py's instructions; a test compares the two.
+# Regenerate with tests/model/test_spectrum.py's instructions; a test compares the two.
 CMFS_FILE = Path(__file__).with_name("cie1931_cmfs.npy")
 
 

@@ -19,6 +19,7 @@ import hmac
 import math
 import time
 from collections import OrderedDict
+from collections.abc import Callable
 
 from starlette.types import ASGIApp, Receive, Scope, Send
 
@@ -34,7 +35,8 @@ MAX_BUCKETS = 65536  # distinct keys and addresses remembered; the least recent 
 class RateLimiter:
     """A token bucket per identity: ``rate`` per second, up to ``burst`` at once."""
 
-    def __init__(self, rate: float, burst: int, clock=time.monotonic) -> None:
+    def __init__(self, rate: float, burst: int,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.rate, self.burst, self.clock = rate, burst, clock
         self.buckets: OrderedDict[str, tuple[float, float]] = OrderedDict()
 
@@ -51,7 +53,7 @@ class RateLimiter:
 
 
 def presented_key(scope: Scope) -> bytes | None:
-    headers = dict(scope["headers"])
+    headers: dict[bytes, bytes] = dict(scope["headers"])
     if b"x-api-key" in headers:
         return headers[b"x-api-key"]
     auth = headers.get(b"authorization", b"")
@@ -68,7 +70,8 @@ def key_matches(keys: list[bytes], given: bytes) -> int | None:
 
 
 class Access:
-    def __init__(self, app: ASGIApp, settings: Settings, on_reject) -> None:
+    def __init__(self, app: ASGIApp, settings: Settings, on_reject: Callable[[str], None]
+                 ) -> None:
         self.app, self.on_reject = app, on_reject
         self.keys = secrets(settings.api_keys)
         self.signing_keys = secrets(settings.signing_key)

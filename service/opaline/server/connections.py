@@ -20,6 +20,7 @@ timeout is counted in ``STATS`` (exported on /metrics).
 
 from __future__ import annotations
 
+import asyncio
 import json
 from collections import Counter
 
@@ -44,7 +45,12 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
     per_client: Counter[str] = Counter()
 
     class Guarded(H11Protocol):
-        def connection_made(self, transport) -> None:  # type: ignore[override]
+        _timer: asyncio.TimerHandle | None
+        _write_timer: asyncio.TimerHandle | None
+
+        # uvicorn's H11Protocol narrows asyncio's BaseTransport to Transport here, with
+        # the same ignore in its own source: an override of it inherits the mismatch.
+        def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
             super().connection_made(transport)
             self._timer = self._write_timer = None
             self._address = self.client[0] if self.client else "unknown"

@@ -28,7 +28,8 @@ async def app_settings(request: Request) -> Settings:
     signature (0.1 ms of each cache miss, docs/speed.md, "The path around the render")."""
     override = request.app.dependency_overrides.get(get_settings)
     if override is None:
-        return getattr(request.app.state, "settings", None) or get_settings()
+        settings: Settings = getattr(request.app.state, "settings", None) or get_settings()
+        return settings
     settings = override()
     return await settings if inspect.isawaitable(settings) else settings
 
@@ -42,12 +43,14 @@ async def get_service(request: Request) -> Service:
 
 async def turntables(request: Request) -> OrderedDict[str, Any]:
     """The turntables this app knows, the latest last (``turntable_routes.Turntable``)."""
-    return request.app.state.turntables
+    known: OrderedDict[str, Any] = request.app.state.turntables
+    return known
 
 
 async def turntable_lanes(request: Request) -> asyncio.Semaphore:
     """The frame lanes every turntable shares: one per worker."""
-    return request.app.state.turntable_lanes
+    lanes: asyncio.Semaphore = request.app.state.turntable_lanes
+    return lanes
 
 
 SettingsDep = Annotated[Settings, Depends(app_settings)]

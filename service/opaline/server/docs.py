@@ -49,7 +49,7 @@ def docs_csp(html: bytes) -> str:
 
 
 def _with_csp(page: HTMLResponse) -> HTMLResponse:
-    page.headers["Content-Security-Policy"] = docs_csp(page.body)
+    page.headers["Content-Security-Policy"] = docs_csp(bytes(page.body))  # bytes already
     return page
 
 

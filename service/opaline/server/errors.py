@@ -13,7 +13,8 @@ counted under its reason. ``install`` puts the handlers on an app (the body limi
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Awaitable, Callable, Mapping, Sequence
+from typing import Any, TypeVar
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -97,6 +98,10 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
 # Handlers
 
 
+# describe_errors or _validation_lines: an errors() list and a model → one line per error
+LinesOf = Callable[[list[Any], type[BaseModel]], list[str]]
+
+
 def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> list[str]:
     """describe_errors' lines for FastAPI's errors, whose locations start with 'body'/'query'."""
     lines, rest = [], []
@@ -114,17 +119,17 @@ def _validation_lines(errors: list[dict[str, Any]], model: type[BaseModel]) -> l
     return lines + describe_errors(rest, model)
 
 
-def _field_of(loc: tuple) -> str | None:
+def _field_of(loc: tuple[str | int, ...]) -> str | None:
     """The top-level request field of an error location (FastAPI's start with body/query)."""
     loc = loc[1:] if loc and loc[0] in ("body", "query", "path") else loc
     return loc[0] if loc and isinstance(loc[0], str) else None
 
 
-def _validation_fields(errors: list[dict[str, Any]], model: type[BaseModel],
-                       lines_of: Any) -> list[dict[str, str]]:
+def _validation_fields(errors: Sequence[Mapping[str, Any]], model: type[BaseModel],
+                       lines_of: LinesOf) -> list[dict[str, str]]:
     """``fields`` of a 422: each error about a field, with the line ``lines_of`` gives it
     alone (the lines are written one per error, so they are those of ``detail``)."""
-    found = []
+    found: list[dict[str, str]] = []
     for err in errors:
         name = _field_of(tuple(err.get("loc", ())))
         if name is not None:
@@ -133,7 +138,7 @@ def _validation_fields(errors: list[dict[str, Any]], model: type[BaseModel],
 
 
 def problem(status: int, reason: str, detail: str | list[str],
-            headers: dict[str, str] | None = None,
+            headers: Mapping[str, str] | None = None,
             fields: list[dict[str, str]] | None = None) -> JSONResponse:
     """The one error body: ``{"error": reason, "detail": [lines]}``; a 422's also has
     ``fields``, its problems about a request field (``[{"field": name, "message": line}]``)."""
@@ -196,9 +201,19 @@ async def on_crash(request: Request, exc: Exception) -> JSONResponse:
 
 def install(app: FastAPI) -> None:
     """A handler for every public error, each counting its rejections."""
-    app.add_exception_handler(RequestValidationError, on_invalid)
-    app.add_exception_handler(ValidationError, on_invalid_model)
-    app.add_exception_handler(PublicError, on_public_error)
-    app.add_exception_handler(HTTPException, on_http_error)
-    app.add_exception_handler(ClientDisconnect, on_gone)
-    app.add_exception_handler(Exception, on_crash)
+    _handle(app, RequestValidationError, on_invalid)
+    _handle(app, ValidationError, on_invalid_model)
+    _handle(app, PublicError, on_public_error)
+    _handle(app, HTTPException, on_http_error)
+    _handle(app, ClientDisconnect, on_gone)
+    _handle(app, Exception, on_crash)
+
+
+E = TypeVar("E", bound=Exception)
+
+
+def _handle(app: FastAPI, kind: type[E], handler: Callable[[Request, E], Awaitable[Response]]
+            ) -> None:
+    # Starlette calls a handler with the class it was registered for, but its stubs type
+    # every handler as taking any Exception, so no narrower handler fits them.
+    app.add_exception_handler(kind, handler)  # type: ignore[arg-type]

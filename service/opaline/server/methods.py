@@ -15,8 +15,10 @@ so that a new tuple field repeats without a change here.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from urllib.parse import parse_qsl
 
+from starlette.applications import Starlette
 from starlette.responses import Response
 from starlette.routing import Match, Mount
 from starlette.types import ASGIApp, Receive, Scope, Send
@@ -28,12 +30,12 @@ REPEATABLE = tuple_fields(RenderQuery) | tuple_fields(MdfQuery)
 PROBED = ("GET", "POST", "PUT", "PATCH", "DELETE")
 
 
-def allowed_methods(app: ASGIApp, scope: Scope) -> set[str]:
+def allowed_methods(app: Starlette, scope: Scope) -> set[str]:
     """The methods some route of ``app`` answers on this path (HEAD with GET, OPTIONS always).
 
     Asked of the routes themselves, one method at a time, so included routers count."""
     methods: set[str] = set()
-    for route in app.router.routes:  # type: ignore[attr-defined]
+    for route in app.router.routes:
         if isinstance(route, Mount):  # static files: GET (and HEAD) whatever the method
             if route.matches(scope)[0] is not Match.NONE:
                 methods.add("GET")
@@ -53,7 +55,8 @@ def repeated(query_string: bytes) -> list[str]:
 
 
 class Methods:
-    def __init__(self, app: ASGIApp, routes_of: ASGIApp, on_reject) -> None:
+    def __init__(self, app: ASGIApp, routes_of: Starlette, on_reject: Callable[[str], None]
+                 ) -> None:
         self.app, self.routes_of, self.on_reject = app, routes_of, on_reject
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:

@@ -66,6 +66,8 @@ def documented(model: type[BaseModel]) -> dict[str, Any]:
 
     async def route(**_: Any) -> None: ...
 
+    # FastAPI reads a route's parameters through inspect, which honours __signature__;
+    # typeshed's function type does not declare the attribute.
     route.__signature__ = inspect.Signature([inspect.Parameter(  # type: ignore[attr-defined]
         "query", inspect.Parameter.KEYWORD_ONLY, annotation=Annotated[model, Query()])])
     probe = FastAPI()

@@ -10,6 +10,7 @@ withdraws the job (dropped from the queue, or stopped between samples).
 from __future__ import annotations
 
 import time
+from collections.abc import Awaitable, Callable
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, Request
@@ -48,7 +49,7 @@ def check_mdf_limits(params: MdfQuery, settings: Settings) -> None:
     check_plot_cost(params.size, params.wavelengths, settings.cost_budget)
 
 
-def client_gone(request: Request):
+def client_gone(request: Request) -> Callable[[], Awaitable[None]]:
     """An awaitable that resolves when the client disconnects (the body is already read)."""
     async def wait() -> None:
         while (await request.receive())["type"] != "http.disconnect":

@@ -79,8 +79,7 @@ class WorkerPool:
             log.error("no render worker has a GL context: %s",
                       "; ".join(s.error or s.state for s in self.slots))
             return
-        # Task declares label settable, a frozen dataclass's is read-only: fix in workers/tasks.py.
-        tasks: list[Task | None] = [self.warmup, CalibrateTask() if self.calibrate else None]  # type: ignore[list-item]
+        tasks: list[Task | None] = [self.warmup, CalibrateTask() if self.calibrate else None]
         with self._cond:  # first in the queue, never expiring, counted in the backlog
             for task in filter(None, tasks):
                 job = Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf,

@@ -33,7 +33,9 @@ PRIVATE = Context(Limits(cost_budget=None), no_meshes)
 
 
 class Task(Protocol):
-    label: str
+    # Read-only, so a frozen dataclass's field or a property both satisfy it.
+    @property
+    def label(self) -> str: ...
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes: ...
 

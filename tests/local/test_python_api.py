@@ -19,7 +19,7 @@ from opaline.model.params import RenderRequest
 from opaline.model.presets import UnknownPreset
 
 pytestmark = pytest.mark.gl
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DISC = {"preset": "cd-rom", "mu_f": 6, "width": 64, "height": 48, "quality": "draft"}
 
 

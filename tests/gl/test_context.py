@@ -15,7 +15,7 @@ from opaline.gl import context, osmesa
 from opaline.gl.context import ContextError, create_context, pick_egl_device, requested_backend
 from opaline.settings import SettingsError
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SOFTWARE = "EGL_MESA_device_software"
 
 # Makes libOSMesa unfindable in a child process, leaving every other library alone.

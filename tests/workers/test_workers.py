@@ -24,7 +24,7 @@ from opaline.workers.pool import WorkerPool
 from worker_helpers import CrashTask, EchoTask, GateTask, null_renderer
 
 WAIT = 20.0
-TESTS = Path(__file__).resolve().parent
+TESTS = Path(__file__).resolve().parents[1]  # tests/, where worker_helpers.py is
 
 
 @pytest.fixture

@@ -10,11 +10,10 @@ import pytest
 from fastapi.testclient import TestClient
 from PIL import Image
 
-from mesh_helpers import FORMATS, broken_files, mesh_bytes
+from mesh_helpers import FORMATS, assert_framed, broken_files, mesh_bytes
 from opaline.server.api import create_app
 from opaline.server.meshstore import MeshStore, MeshTooLarge, UnknownMesh
 from opaline.settings import Settings
-from test_meshes import assert_framed
 
 SMALL = "width=96&height=80&quality=draft&transparent=true"
 

@@ -19,7 +19,7 @@ from opaline.cli import main as cli
 from opaline.model.presets import all_presets
 from opaline.resources import PRESETS_ENV, builtin_presets_dir
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--size", "16x16", "--quality", "draft"]
 gl = pytest.mark.usefixtures("shared_renderer")
 

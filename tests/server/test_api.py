@@ -532,7 +532,7 @@ def test_openapi_says_what_each_health_route_means(client):
 
 def test_container_health_check_asks_readiness():
     """The image is unhealthy when no worker can render: its HEALTHCHECK asks /readyz."""
-    dockerfile = (Path(__file__).resolve().parent.parent / "Dockerfile").read_text()
+    dockerfile = (Path(__file__).resolve().parents[2] / "Dockerfile").read_text()
     check = dockerfile[dockerfile.index("HEALTHCHECK"):]
     assert "/readyz" in check.split("\n\n")[0] and "/healthz" not in check.split("\n\n")[0]
 

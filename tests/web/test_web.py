@@ -13,7 +13,7 @@ import pytest
 
 from opaline.server.localserver import LocalServer, ServerError, loopback_env
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = Path("/usr/bin/chromium")
 # Only 127.0.0.1 traffic: no background networking, updates, sync or QUIC probes.
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

@@ -21,7 +21,7 @@ from opaline.batch.sheet import THUMB
 from opaline.cli.main import main
 
 pytestmark = pytest.mark.gl
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SMALL = 'width = 64\nheight = 64\nquality = "draft"\n'
 
 MIXED = {

@@ -12,7 +12,7 @@ from opaline.cli.main import main
 from opaline.model import materials
 from opaline.model.materials import MaterialError, collect, load_material, material_schema
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def write(path: Path, text: str) -> Path:

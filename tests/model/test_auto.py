@@ -18,7 +18,7 @@ from opaline.model.request import resolve
 from opaline.model.tiers import TIERS, Tier
 from opaline.resources import sources_digest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 REGENERATE = "python bench/accuracy.py --write-table"
 
 

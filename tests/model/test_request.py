@@ -16,7 +16,7 @@ from opaline.model.presets import get_preset
 from opaline.model.request import CostError, Job, check_cost, resolve
 from opaline.model.tiers import TIERS
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def custom_preset(**defaults):

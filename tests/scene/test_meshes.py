@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from mesh_helpers import FORMATS, broken_files, mesh_bytes, torus_with_uvs
+from mesh_helpers import FORMATS, assert_framed, broken_files, mesh_bytes, torus_with_uvs
 from opaline.cli import main as cli
 from opaline.gl.buffers import bounding_sphere
 from opaline.model.camera import fit_matrix, framing_distance
@@ -95,20 +95,6 @@ def test_fit_matrix_puts_the_bounds_on_a_unit_sphere():
     assert distances.max() == pytest.approx(1.0) and distances.min() < 0.2
     # The unit sphere at that distance touches the narrower side of the frustum, with margin.
     assert 2.5 < framing_distance(1.0, 35.0, 1.0) < 4.0
-
-
-def coverage_box(alpha: np.ndarray) -> tuple[int, int, int, int]:
-    rows, cols = np.nonzero(alpha > 0.5)
-    return rows.min(), rows.max(), cols.min(), cols.max()
-
-
-def assert_framed(alpha: np.ndarray) -> None:
-    """The object's bounding box is inside the image and covers a fair part of it."""
-    h, w = alpha.shape
-    top, bottom, left, right = coverage_box(alpha)
-    assert top > 0 and left > 0 and bottom < h - 1 and right < w - 1, (top, bottom, left, right)
-    assert (bottom - top + 1) * (right - left + 1) > 0.15 * h * w
-    assert max(bottom - top + 1, right - left + 1) > 0.6 * min(h, w)
 
 
 @pytest.mark.gl
