@@ -64,6 +64,7 @@ class Job:
     environment_intensity: float | None = None
     environment_lights: int | None = None
     environment_background: bool | None = None
+    environment_blur: float | None = None
 
     @property
     def quality(self) -> str:

@@ -47,7 +47,8 @@ class SceneFields(BaseModel):
 
     environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
         None, description="Light the scene with an environment instead of the preset's lights: "
-                          "'studio', 'sky', or an .hdr/.exr file of the environments folder.")
+                          "'studio', 'neutral', 'sky', or an .hdr/.exr file of the "
+                          "environments folder.", examples=["studio", "neutral", "sky"])
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Turns the environment about the up axis, degrees (default 0).")
     environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(
@@ -59,3 +60,6 @@ class SceneFields(BaseModel):
     environment_background: bool | None = Field(
         None, description="Show the environment behind the object instead of the preset's "
                           "background (default false).")
+    environment_blur: Annotated[float, Field(ge=0.0, le=1.0)] | None = Field(
+        None, description="Blurs the environment shown behind the object, 0 … 1: 0 (default) "
+                          "sharp, 1 a soft wash about 30° across; the lighting is unchanged.")
