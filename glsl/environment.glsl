@@ -13,6 +13,7 @@ uniform vec2 u_size;
 uniform vec2 u_jitter;  // the surface pass's sub-pixel offset, in NDC units
 uniform float u_rotation;  // radians the environment is turned about +y
 uniform float u_intensity;
+uniform float u_lod;  // the mip level environment_blur asks for; 0 is the sharp map
 
 out vec4 frag_color;
 
@@ -25,7 +26,7 @@ void main() {
     float azimuth = atan(d.z, d.x) - u_rotation;
     float elevation = asin(clamp(d.y, -1.0, 1.0));
     vec2 uv = vec2(fract(azimuth / TWO_PI), 0.5 + elevation / PI);
-    // Explicit LOD 0: the azimuth's wrap would otherwise pick a tiny mip along the seam.
-    frag_color = vec4(textureLod(u_environment, uv, 0.0).rgb * u_intensity, 1.0);
+    // Explicit LOD: the azimuth's wrap would otherwise pick a tiny mip along the seam.
+    frag_color = vec4(textureLod(u_environment, uv, u_lod).rgb * u_intensity, 1.0);
 }
 #endif

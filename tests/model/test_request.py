@@ -166,7 +166,7 @@ def test_cache_key_changes_with_material(field, value):
     [("width", 128), ("height", 128), ("format", "png16"), ("format", "npy"), ("quality", "draft"),
      ("quality", "high"), ("samples", 3), ("wavelengths", 32), ("aa", "none"), ("exposure", 2.0),
      ("tonemap", "none"), ("transparent", True), ("light_azimuth", 30.0),
-     ("light_elevation", 10.0)],
+     ("light_elevation", 10.0), ("environment_blur", 0.5)],
 )
 def test_cache_key_changes_with_render_fields(field, value):
     """Changing size, format, tier or any other render field changes the cache key."""

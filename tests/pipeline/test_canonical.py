@@ -63,7 +63,9 @@ FIELD_VALUES = st.fixed_dictionaries({}, optional={
     "width": st.integers(16, 512), "mu_f": st.floats(0, 1000), "theta1": st.floats(-6, 6),
     "exposure": st.floats(0.01, 1000), "aa": st.sampled_from(["none", "analytic"]),
     "albedo": st.tuples(*[st.floats(0, 1)] * 3), "light_azimuth": st.floats(-360, 360),
-    "camera_elevation": st.floats(-89, 89), "environment": st.sampled_from(["studio", "sky"]),
+    "camera_elevation": st.floats(-89, 89),
+    "environment": st.sampled_from(["studio", "neutral", "sky"]),
+    "environment_background": st.booleans(), "environment_blur": st.floats(0, 1),
     "max_flip": st.floats(0.001, 1.0), "transparent": st.booleans()})
 
 

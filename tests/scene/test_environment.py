@@ -8,7 +8,7 @@ import pytest
 
 from opaline.model.params import RenderRequest
 from opaline.scene import environments
-from opaline.scene.mediancut import directions, median_cut
+from opaline.scene.mediancut import LUMA, directions, median_cut
 
 COUNTS = (1, 4, 16, 64)
 REFERENCE = 256
@@ -97,3 +97,117 @@ def test_background_shows_the_environment(local):
     assert corner[2] > corner[0] and corner[2] > 0.05  # sky blue above
     sky = environments.sky()
     assert corner[2] <= sky[..., 2].max()
+
+
+@pytest.mark.parametrize("name", ["studio", "neutral"])
+def test_product_maps_are_finite_and_non_negative(name):
+    radiance = environments.resolve_map(name, None)
+    assert radiance.dtype == np.float32 and radiance.ndim == 3 and radiance.shape[2] == 3
+    assert np.all(np.isfinite(radiance)) and radiance.min() > 0.0  # no black anywhere
+    assert environments.resolve_map(name, None) is radiance  # built once, kept
+    assert not radiance.flags.writeable
+
+
+def test_studio_is_a_room_with_panels_and_the_key_above_front():
+    """The brightest region is the key, above the object on the camera's side (+z); the
+    other panels are sharp rectangles well above the walls, which are a gradient, not flat."""
+    radiance = environments.resolve_map("studio", None).astype(np.float64)
+    d, _ = directions(*radiance.shape[:2])
+    luma = radiance @ LUMA
+    brightest = d[luma >= 0.98 * luma.max()]
+    assert len(brightest) > 500  # a large panel, not a spot
+    assert np.all(brightest[:, 1] > 0.5) and np.all(brightest[:, 2] > 0.0)
+    assert brightest[:, 2].mean() > 0.3  # in front, toward the camera
+    panels, walls = luma >= 0.3, luma[luma <= 0.18]  # the dimmest panel is 0.33
+    assert walls.max() > 2.5 * walls.min()  # a gradient
+    assert 0.02 < float(np.mean(walls)) < 0.1
+    # Panels have sharp edges: few texels lie between wall and panel levels (the
+    # 2×2-averaged edge texels only).
+    between = ~panels & (luma > 0.18)
+    assert between.sum() < 0.25 * panels.sum()
+    # Six panels: count the separate bright regions along the horizon and overhead.
+    scipy_ndimage = pytest.importorskip("scipy.ndimage")
+    _, count = scipy_ndimage.label(np.concatenate([panels, panels[:, :1]], 1))
+    assert count >= 6
+
+
+def test_studio_keeps_the_old_studios_light():
+    """Exposures stay sensible: the total and the irradiance on the faces toward the camera
+    and upward stay in the range of the earlier studio (1.70, 0.70, 0.86)."""
+    radiance = environments.resolve_map("studio", None).astype(np.float64)
+    d, solid = directions(*radiance.shape[:2])
+    energy = (radiance @ LUMA) * solid
+    assert 1.4 < energy.sum() < 2.1
+    assert 0.45 < (energy * np.clip(d[..., 2], 0, None)).sum() < 0.85  # toward +z
+    assert 0.7 < (energy * np.clip(d[..., 1], 0, None)).sum() < 1.05  # upward
+
+
+def test_neutral_is_a_featureless_gradient():
+    radiance = environments.resolve_map("neutral", None)
+    assert radiance.max() <= 0.45
+    np.testing.assert_array_equal(radiance, radiance[:, :1].repeat(radiance.shape[1], 1))
+    rows = radiance[:, 0] @ LUMA  # row 0 is the zenith
+    assert np.all(np.diff(rows) < 0) and rows[0] > 5 * rows[-1]
+
+
+def test_neutral_is_listed_where_the_built_ins_are():
+    assert "neutral" in environments.BUILTIN
+    with pytest.raises(ValueError, match="studio, neutral, sky"):
+        environments.check_name("gallery", None)
+    description = RenderRequest.model_fields["environment"].description or ""
+    assert all(f"'{name}'" in description for name in environments.BUILTIN)
+
+
+BACKDROP = dict(preset="sphere", environment="studio", environment_background=True,
+                width=64, height=64, samples=1, wavelengths=0, aa="none", camera_distance=10.0,
+                camera_azimuth=180.0)  # far off, so the sphere is a dot; looking at the seam (+x)
+
+
+def _backdrop(local, **fields):
+    image = local.render_array(RenderRequest(**{**BACKDROP, **fields}))[..., :3]
+    image = image.astype(np.float64)
+    image[28:36, 28:36] = np.nan  # the sphere
+    return image
+
+
+@pytest.mark.gl
+def test_blur_zero_is_the_sharp_backdrop(local):
+    """Blur 0 draws what no blur draws, bit for bit, and keeps the panels' edges."""
+    sharp = local.render_array(RenderRequest(**BACKDROP))
+    zero = local.render_array(RenderRequest(**BACKDROP, environment_blur=0.0))
+    np.testing.assert_array_equal(zero, sharp)
+    slight = local.render_array(RenderRequest(**BACKDROP, environment_blur=0.2))
+    assert not np.array_equal(slight, sharp)
+
+
+def _high_frequency(image):
+    laplacian = (4 * image[1:-1, 1:-1] - image[:-2, 1:-1] - image[2:, 1:-1]
+                 - image[1:-1, :-2] - image[1:-1, 2:])
+    return float(np.nanmean(np.abs(laplacian)))
+
+
+@pytest.mark.gl
+def test_blur_one_is_smooth_and_keeps_the_mean(local):
+    """Full blur: the backdrop's high-frequency energy falls to a small part of the sharp
+    one's (panels and the floor's edge washed out), its mean stays, and the blur grows
+    with the field (the seam across the view stays invisible: no jump between columns)."""
+    sharp, half, full = (_backdrop(local, environment_blur=b) for b in (0.0, 0.5, 1.0))
+    assert _high_frequency(full) < 0.15 * _high_frequency(sharp)
+    assert _high_frequency(full) < _high_frequency(half) < _high_frequency(sharp)
+    assert np.nanmean(full) == pytest.approx(np.nanmean(sharp), rel=0.15)
+    columns = np.abs(np.diff(np.nanmean(full, axis=(0, 2))))
+    assert columns.max() < 4 * np.median(columns) + 1e-3
+
+
+@pytest.mark.gl
+def test_backdrop_leaves_the_object_alone(local):
+    """The map behind the object is bound to a texture unit of its own: a preset with a
+    thickness map (nacre-film) draws the same object with and without the backdrop (the
+    map once shared the thickness map's unit, so the film read the sky as its thickness)."""
+    common = dict(preset="nacre-film", environment="sky", width=48, height=48, samples=1,
+                  wavelengths=0, aa="none")
+    shown = local.render_array(RenderRequest(environment_background=True, **common))
+    plain = local.render_array(RenderRequest(**common))
+    covered = plain[..., 3] == 1.0
+    assert covered.sum() > 300
+    np.testing.assert_array_equal(shown[covered, :3], plain[covered, :3])

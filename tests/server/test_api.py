@@ -257,6 +257,7 @@ def test_web_page_served_when_present(tmp_path):
     ("albedo=0.1,2,0.3", "albedo", "[0 … 1]"),
     ("wavelengths=3", "wavelengths=", "4 … 128"),
     ("exposure=0", "exposure=", "(0 … 1000]"),
+    ("environment_blur=1.5", "environment_blur=", "[0 … 1]"),
 ])
 def test_out_of_range_query_is_422_naming_field_and_range(client, query, field, allowed):
     """An out-of-range parameter answers 422, naming the field, the value and the range."""

@@ -160,6 +160,39 @@ def test_out_of_range_value_shows_the_api_message_by_its_control(page):
     assert shown_bytes(page) != good
 
 
+def test_environment_picker_backdrop_and_blur(page):
+    """The environment group picks a built-in (listed from the schema) or a typed file
+    name, and its backdrop and blur controls change the preview; the quick picker by the
+    mesh drop shows the same choice."""
+    open_page(page)
+    options = page.eval_on_selector_all("#in-environment option", "os => os.map(o => o.text)")
+    assert options == ["preset's", "studio", "neutral", "sky", "file…"], options
+    assert page.locator("#in-environment-file").is_hidden()
+    plain = shown_bytes(page)
+    page.select_option("#in-environment", "neutral")
+    settle(page)
+    lit = shown_bytes(page)
+    assert lit != plain and "environment=neutral" in page.get_attribute("#preview", "data-url")
+    assert page.input_value("#env-pick") == "neutral"
+    page.check("#in-environment_background")
+    settle(page)
+    backdrop = shown_bytes(page)
+    assert backdrop != lit
+    page.select_option("#in-environment", "studio")
+    settle(page)
+    sharp = shown_bytes(page)
+    page.fill("#in-environment_blur", "0.5")
+    settle(page)
+    assert "environment_blur=0.5" in page.get_attribute("#preview", "data-url")
+    assert shown_bytes(page) != sharp
+    page.select_option("#in-environment", label="file…")
+    assert page.locator("#in-environment-file").is_visible()
+    page.select_option("#env-pick", "sky")
+    settle(page)
+    assert page.input_value("#in-environment") == "sky"
+    assert page.locator("#in-environment-file").is_hidden()
+
+
 def test_copied_curl_returns_the_shown_bytes(page, tmp_path):
     """Dragging the preview moves the light; "Copy as curl", run, gets the bytes shown."""
     open_page(page, "?preset=cd-rom")

@@ -1,8 +1,12 @@
 """The environment as the background (``environment_background``): its map drawn behind
 the object in every sample, before the surface pass, with the lights' rotation and scale.
 
-The maps are uploaded once per environment and kept (a few; they are 128×256 RGB
-float for the built-in ones), released with the renderer.
+The maps are uploaded once per environment with their mip chain and kept (a few;
+128×256 or 256×512 RGB float for the built-in ones), released with the renderer.
+``environment_blur`` reads a coarser mip, trilinear between levels: at 1 the level
+whose texels span ``BLUR_DEGREES`` (counted from the map's own texel, so a blur is
+the same angle on any map), in between a span growing geometrically from the map's
+texel; 0 reads the sharp map as before.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from opaline.model.request import Job
 from opaline.scene.environments import resolve_map
 
 KEPT = 4
+BLUR_DEGREES = 30.0  # a texel's span at environment_blur = 1: a soft wash, no features
 
 
 class Backgrounds:
@@ -41,7 +46,8 @@ class Backgrounds:
             # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
             data = np.ascontiguousarray(radiance[::-1], dtype="f4")
             found = self.ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
-            # The mip chain is what environment light reads (filtered importance sampling).
+            # The one place the map's sampling is set: environment light (filtered
+            # importance sampling) and the backdrop's blur read this chain.
             found.build_mipmaps()
             found.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             found.repeat_x, found.repeat_y = True, False
@@ -71,7 +77,8 @@ class Backgrounds:
             "u_environment": texture_units.ENVIRONMENT, "u_size": (float(size[0]), float(size[1])),
             "u_inv_view_proj": np.linalg.inv(view_proj).astype("f4"),
             "u_rotation": math.radians(job.environment_rotation or 0.0),
-            "u_intensity": intensity})
+            "u_intensity": intensity, "u_lod": blur_level(job.environment_blur or 0.0,
+                                                          texture.height)})
 
         def draw(jitter: tuple[float, float]) -> None:
             texture.use(location=texture_units.ENVIRONMENT)
@@ -86,3 +93,12 @@ class Backgrounds:
             texture.release()
         self._maps.clear()
         self._irradiance.clear()
+
+
+def blur_level(blur: float, height: int) -> float:
+    """The mip level for ``blur`` on a map ``height`` rows tall (a row spans 180° /
+    height): 0 at no blur, the level whose texels span ``BLUR_DEGREES`` at 1, linear in
+    level (so geometric in angle) between."""
+    if blur <= 0.0:
+        return 0.0
+    return blur * max(0.0, math.log2(BLUR_DEGREES * height / 180.0))

@@ -65,6 +65,7 @@ class Job:
     environment_lights: int | None = None
     environment_samples: int | None = None
     environment_background: bool | None = None
+    environment_blur: float | None = None
 
     @property
     def quality(self) -> str:

@@ -14,11 +14,14 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from opaline.scene.environments import BUILTIN
+
 TangentField = Literal["auto", "uv", "concentric", "projected"]
 Finite3 = tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
                 Annotated[float, Field(ge=-1e6, le=1e6)]]
 MESH_FIELDS = ("mesh", "tangent_field", "tangent_axis")
 ORBIT_FIELDS = ("camera_azimuth", "camera_elevation", "camera_distance")
+BUILT_IN = ", ".join(f"'{name}'" for name in BUILTIN)
 
 
 class SceneFields(BaseModel):
@@ -47,7 +50,8 @@ class SceneFields(BaseModel):
 
     environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
         None, description="Light the scene with an environment instead of the preset's lights: "
-                          "'studio', 'sky', or an .hdr/.exr file of the environments folder.")
+                          f"{BUILT_IN}, or an .hdr/.exr file of the environments folder.",
+        examples=list(BUILTIN))
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Turns the environment about the up axis, degrees (default 0).")
     environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(
@@ -65,3 +69,6 @@ class SceneFields(BaseModel):
     environment_background: bool | None = Field(
         None, description="Show the environment behind the object instead of the preset's "
                           "background (default false).")
+    environment_blur: Annotated[float, Field(ge=0.0, le=1.0)] | None = Field(
+        None, description="Blurs the environment shown behind the object, 0 … 1: 0 (default) "
+                          "sharp, 1 a soft wash about 30° across; the lighting is unchanged.")

@@ -22,7 +22,8 @@ GROUPS: list[tuple[str, str, tuple[str, ...]]] = [
                                   "camera_elevation", "camera_distance")),
     ("environment", "Environment", ("environment", "environment_rotation",
                                     "environment_intensity", "environment_lights",
-                                    "environment_samples", "environment_background")),
+                                    "environment_samples", "environment_background",
+                                    "environment_blur")),
     ("tier", "Quality tier overrides", ("samples", "wavelengths", "aa", "max_flip",
                                         "max_delta_e")),
 ]

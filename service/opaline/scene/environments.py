@@ -5,8 +5,8 @@ convention), turned into directional lights by ``mediancut.median_cut``. The
 procedural ones are made here, in closed form, at a fixed size, so they cost
 nothing to ship and are the same on every machine:
 
-* ``studio``: a dim grey room with a large soft box above and in front, a
-  strip light to the side and a faint fill from behind, as product shots use;
+* ``studio``: a grey room with soft-box panels, the key above and in front, as
+  product shots use; ``neutral``: a soft grey gradient (both in ``scene.studio``);
 * ``sky``: a clear sky (brighter at the horizon, deeper blue at the zenith),
   a sun 35° up, and a dim ground.
 
@@ -24,42 +24,16 @@ from pathlib import Path
 import numpy as np
 
 from opaline.scene.mediancut import directions, median_cut
+from opaline.scene.studio import neutral, studio
 
-BUILTIN = ("studio", "sky")
-SIZE = (128, 256)  # rows, columns: 1.4° per texel, enough for soft boxes and the sun's disc
+BUILTIN = ("studio", "neutral", "sky")
+SIZE = (128, 256)  # rows, columns: 1.4° per texel, enough for the sun's disc
 SUFFIXES = (".hdr", ".exr")
 CACHED = 8
 
 
 class EnvironmentMapError(ValueError):
     """An environment that is not known or cannot be read; the message says which."""
-
-
-def _box(d: np.ndarray, centre: tuple[float, float, float], half_width: float,
-         half_height: float) -> np.ndarray:
-    """1 inside a rectangle of angular half-sizes (radians) facing ``centre``, soft edges."""
-    c = np.asarray(centre, dtype=np.float64)
-    c /= np.linalg.norm(c)
-    right = np.cross((0.0, 1.0, 0.0), c)
-    right = right / np.linalg.norm(right) if np.linalg.norm(right) > 1e-9 else np.array([1.0, 0, 0])
-    up = np.cross(c, right)
-    facing = d @ c
-    x = np.arctan2(d @ right, facing)
-    y = np.arctan2(d @ up, facing)
-    edge = np.maximum(np.abs(x) / half_width, np.abs(y) / half_height)
-    weight: np.ndarray = np.clip((1.15 - edge) / 0.3, 0.0, 1.0) * (facing > 0)
-    return weight
-
-
-def studio() -> np.ndarray:
-    d, _ = directions(*SIZE)
-    up = d[..., 1:2]
-    room = np.where(up > 0, 0.03, 0.015) * np.ones(3)  # walls a little brighter than the floor
-    key = _box(d, (0.6, 0.9, 0.8), 0.45, 0.3)[..., None] * np.array([2.0, 1.95, 1.85])
-    strip = _box(d, (-1.0, 0.25, 0.2), 0.12, 0.55)[..., None] * np.array([1.1, 1.15, 1.25])
-    rim = _box(d, (0.2, 0.4, -1.0), 0.3, 0.2)[..., None] * np.array([0.5, 0.5, 0.5])
-    radiance: np.ndarray = room + key + strip + rim
-    return radiance.astype(np.float32)
 
 
 def sky() -> np.ndarray:
@@ -119,15 +93,17 @@ def check_name(name: str, folder: Path | None) -> Path | None:
         path = Path(folder) / name
         if path.is_file():
             return path
-    raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, sky, or an "
-                            ".hdr/.exr file of the environments folder")
+    raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, neutral, "
+                            "sky, or an .hdr/.exr file of the environments folder")
 
 
 def resolve_map(name: str, folder: Path | None) -> np.ndarray:
     path = check_name(name, folder)
     if path is not None:
         return read_file(path)
-    return studio() if name == "studio" else sky()
+    if name == "studio":
+        return studio()
+    return neutral() if name == "neutral" else sky()
 
 
 # (name, count, folder) -> (directions, irradiances)

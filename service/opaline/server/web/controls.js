@@ -3,10 +3,11 @@
 import { $, h } from './dom.js';
 import { vectorControl } from './color.js';
 import { boolControl, enumControl, numberControl, textControl } from './inputs.js';
+import { pickControl } from './picker.js';
 import { state, valueOf } from './state.js';
 
 const BUILDERS = { number: numberControl, enum: enumControl, bool: boolControl,
-  vector: vectorControl, text: textControl };
+  vector: vectorControl, text: textControl, pick: pickControl };
 // Groups shown folded (their fields are rarely set by hand).
 const FOLDED = new Set(['tier']);
 
@@ -32,6 +33,11 @@ export function refreshField(name, source) {
   const control = state.controls.get(name);
   if (!control) return;
   control.show(valueOf(name), source);
+  // Quick pickers elsewhere on the page (data-mirrors) show the same value.
+  for (const mirror of document.querySelectorAll(`select[data-mirrors="${name}"]`)) {
+    const value = valueOf(name) ?? '';
+    mirror.value = [...mirror.options].some((o) => o.value === value) ? value : '';
+  }
   const changed = name in state.overrides;
   control.wrap.classList.toggle('changed', changed);
   control.reset.hidden = !changed;

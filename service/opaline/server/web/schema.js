@@ -36,7 +36,7 @@ function kindOf(schema, main) {
 function specOf(schema, name, prop) {
   const alternatives = (prop.anyOf || prop.oneOf || [prop]).map((alt) => deref(schema, alt));
   const main = alternatives.find((alt) => alt.type !== 'null') || {};
-  return {
+  const spec = {
     name,
     description: prop.description || main.description || '',
     default: prop.default ?? null,
@@ -45,6 +45,9 @@ function specOf(schema, name, prop) {
     tier: prop['x-tier'] === true,
     ...kindOf(schema, main),
   };
+  // A text field with its usual values listed (examples) is picked from them.
+  const examples = prop.examples ?? main.examples;
+  return spec.kind === 'text' && Array.isArray(examples) ? { ...spec, kind: 'pick', examples } : spec;
 }
 
 // { specs: Map name → spec, order: names in schema order, groups: [{id, title, fields}] };
