@@ -14,11 +14,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from opaline.model.display import (  # noqa: F401 (re-exported: the reference in one place)
-    srgb_decode,
-    srgb_encode,
-    tonemap,
-)
+# Re-exported (as X as X, for the type checker): the reference in one place.
+from opaline.model.display import srgb_decode as srgb_decode
+from opaline.model.display import srgb_encode as srgb_encode
+from opaline.model.display import tonemap as tonemap
 from opaline.model.microfacet import (  # noqa: F401 (re-exported: the reference in one place)
     EPS_DENOM,
     EPS_HALF,
