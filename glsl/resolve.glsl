@@ -1,4 +1,4 @@
-//! defines: TONEMAP_REINHARD TONEMAP_ACES TRANSPARENT DOWNSAMPLE_2X
+//! defines: TONEMAP_REINHARD TONEMAP_ACES TONEMAP_NEUTRAL TRANSPARENT DOWNSAMPLE_2X
 // Averages the accumulated samples and encodes for display: exposure, tone map,
 // sRGB; composited over the background unless the output keeps its alpha.
 // Rows are written top row first (the reverse of GL's order), so the readback

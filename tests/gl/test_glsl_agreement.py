@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from opaline.model import reference as ref
-from opaline.model.params import Material
+from opaline.model.params import Material, RenderRequest
 from stability_cases import random_cases
 
 pytestmark = pytest.mark.gl
@@ -128,3 +128,29 @@ def test_no_specular_when_light_is_opposite_view(renderer):
     gl = renderer.probe(material, n, np.array([[1.0, 0.0, 0.0]]), n, -n)
     expected = 0.5 * np.array([1.0, 0.5, 0.25]) / np.pi
     assert np.allclose(gl[0], expected, rtol=1e-5)
+
+
+@pytest.mark.parametrize("tonemap", ["none", "reinhard", "aces", "neutral"])
+def test_display_encoding_matches_reference(renderer, tonemap):
+    """The resolve's exposure, tone map and sRGB agree with the float64 twin (model/display.py)
+    on the renderer's own linear radiance, over pixels below and above neutral's knee."""
+    from dataclasses import replace
+
+    from opaline.model.display import KS
+    from opaline.model.presets import get_preset
+    from opaline.model.request import resolve
+
+    exposure = 20.0  # cd-rom peaks at 0.03 … 0.2: this spans the knee at KS = 0.76
+    job = resolve(RenderRequest(preset="cd-rom", width=64, height=64, quality="draft",
+                                transparent=True, tonemap=tonemap, exposure=exposure,
+                                format="npy"), get_preset("cd-rom"))
+    linear = renderer.render(job).linear.astype(np.float64)
+    display = renderer.render(replace(job, format="png16")).display
+    coverage = linear[..., 3]
+    covered = coverage > 0.0
+    straight = linear[covered, :3] / coverage[covered, None] * exposure
+    peaks = straight.max(axis=1)
+    assert (peaks < KS).sum() > 50 and (peaks > 2.0).sum() > 50  # both branches exercised
+    expected = ref.srgb_encode(ref.tonemap(straight, tonemap))
+    assert np.abs(display[covered, :3] - expected).max() < 1e-4
+    assert np.allclose(display[..., 3], np.clip(coverage, 0.0, 1.0), atol=1e-6)

@@ -57,7 +57,9 @@ def test_one_pass_at_twice_the_size_matches_four_jittered_passes(renderer, monke
 @pytest.mark.gl
 @pytest.mark.parametrize("name", ["sphere", "nacre", "cd-rom"])
 @pytest.mark.parametrize("transparent", [False, True])
-def test_one_sample_drawn_straight_to_bytes_matches_the_resolve(renderer, name, transparent):
+@pytest.mark.parametrize("tonemap", ["reinhard", "neutral"])
+def test_one_sample_drawn_straight_to_bytes_matches_the_resolve(renderer, name, transparent,
+                                                                tonemap):
     """A 1-sample 8-bit image is drawn and display-encoded by the surface pass itself;
     it is the resolve pass's image (the float path, quantised) within one level, right
     way up, with the same background or alpha."""
@@ -66,7 +68,7 @@ def test_one_sample_drawn_straight_to_bytes_matches_the_resolve(renderer, name, 
     from opaline.output.encode import quantise
 
     job = resolve(RenderRequest(preset=name, width=96, height=64, quality="draft",
-                                transparent=transparent, tonemap="reinhard", exposure=1.5),
+                                transparent=transparent, tonemap=tonemap, exposure=1.5),
                   get_preset(name))
     direct = renderer.render(job).pixels.astype(int)
     resolved = quantise(renderer.render(replace(job, format="png16")).display, 8).astype(int)

@@ -208,7 +208,7 @@ def test_unknown_fields_refused_and_listed():
 @pytest.mark.parametrize(("field", "value", "choices"), [
     ("mdf", "beckmann", ("ashikhmin", "multipeak")),
     ("format", "gif", ("png", "png16", "npy")),
-    ("tonemap", "filmic", ("none", "reinhard", "aces")),
+    ("tonemap", "filmic", ("none", "reinhard", "aces", "neutral")),
     ("quality", "ultra", ("draft", "standard", "high", "reference")),
     ("aa", "msaa", ("none", "analytic")),
 ])

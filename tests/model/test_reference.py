@@ -364,6 +364,33 @@ def test_tonemap_monotone_property(mode, a, b):
     assert float(ref.tonemap(lo, mode)) <= float(ref.tonemap(hi, mode))
 
 
+def test_neutral_tonemap_keeps_hue_and_the_base_colour_range():
+    """PBR Neutral (Khronos spec): colours in [0.08, 0.8] come out 0.04 darker; every output
+    is in [0, 1] and in the plane of its input and the grey axis (same hue); grey is
+    monotone, continuous at both knees; and the inverse (the backdrop's) undoes it."""
+    from opaline.model import display
+
+    rng = np.random.default_rng(21)
+    base = rng.uniform(0.08, 0.8, (2000, 3))
+    assert np.allclose(ref.tonemap(base, "neutral"), base - 0.04, atol=1e-12)
+    x = np.concatenate([rng.uniform(0.0, 1.0, (4000, 3)), 10 ** rng.uniform(-5, 4, (4000, 3))])
+    y = ref.tonemap(x, "neutral")
+    assert np.all((y >= 0.0) & (y <= 1.0))
+    chroma_in = x - x.mean(axis=1, keepdims=True)
+    chroma_out = y - y.mean(axis=1, keepdims=True)
+    cross = np.cross(chroma_in, chroma_out)
+    assert np.abs(cross).max() <= 1e-9 * np.abs(chroma_in).max()
+    assert np.all((chroma_in * chroma_out).sum(axis=1) >= 0.0)  # not turned to the opposite hue
+    grey = np.concatenate([[0.0], np.geomspace(1e-6, 1e6, 4000), [0.08, 0.8]])
+    g = ref.tonemap(grey[:, None] * np.ones(3), "neutral")[:, 0]
+    assert g[0] == 0.0 and np.all(np.diff(g[:-2]) >= 0.0)
+    for knee in (2 * display.F90, display.KS + display.F90):
+        below, above = ref.tonemap(np.array([[knee - 1e-9] * 3, [knee + 1e-9] * 3]), "neutral")
+        assert abs(above[0] - below[0]) < 1e-8
+    back = display.tonemap_inverse(y[x.max(axis=1) < 50], "neutral")
+    assert np.allclose(back, x[x.max(axis=1) < 50], rtol=1e-6, atol=1e-7)
+
+
 # The MDF plot
 
 

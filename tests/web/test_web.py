@@ -121,6 +121,9 @@ def test_page_loads_with_controls_from_the_schema(page):
                  "format"):
         assert page.locator(f"#in-{name}").count() == 1, name
     assert page.locator("#rng-ex").count() == 1 and page.locator("#in-albedo-0").count() == 1
+    tonemaps = page.eval_on_selector_all("#in-tonemap option", "os => os.map(o => o.value)")
+    assert tonemaps == ["none", "reinhard", "aces", "neutral"]
+    assert page.input_value("#in-tonemap") == "neutral"  # the default, shown as chosen
 
 
 def test_preset_and_slider_change_the_preview(page):

@@ -24,15 +24,8 @@ def thickness_texture(ctx: moderngl.Context, field) -> moderngl.Texture | None:
 def backdrop_radiance(background, tonemap: str, exposure: float) -> tuple[float, float, float]:
     """The linear radiance that displays as the preset's background colour after exposure,
     tone map and sRGB encoding: what a film that transmits everything lets through."""
-    from opaline.model.reference import srgb_decode
+    from opaline.model.display import srgb_decode, tonemap_inverse
 
     y = np.clip(srgb_decode(np.asarray(background, dtype=np.float64)), 0.0, 0.999)
-    if tonemap == "reinhard":
-        x = y / (1.0 - y)
-    elif tonemap == "aces":
-        # Inverse of the Narkowicz fit y = x(2.51x + 0.03)/(x(2.43x + 0.59) + 0.14).
-        a, b, c = 2.51 - 2.43 * y, 0.03 - 0.59 * y, -0.14 * y
-        x = (-b + np.sqrt(b * b - 4.0 * a * c)) / (2.0 * a)
-    else:
-        x = y
+    x = tonemap_inverse(y, tonemap)
     return tuple(float(v) for v in x / exposure)

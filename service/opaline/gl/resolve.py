@@ -17,7 +17,8 @@ from opaline.model.request import Job
 
 def tonemap_defines(job: Job) -> dict[str, bool]:
     """The display encoding's defines, shared by the resolve and a direct (one-sample) draw."""
-    return {"TONEMAP_REINHARD": job.tonemap == "reinhard", "TONEMAP_ACES": job.tonemap == "aces"}
+    return {"TONEMAP_REINHARD": job.tonemap == "reinhard", "TONEMAP_ACES": job.tonemap == "aces",
+            "TONEMAP_NEUTRAL": job.tonemap == "neutral"}
 
 
 class Resolver:

@@ -40,7 +40,7 @@ from opaline.model.tiers import AntiAliasName, QualityName
 ImageFormat = Literal["png", "png16", "npy", "webp", "webp-lossless", "avif", "jpeg"]
 # 'auto': the HTTP service picks from the Accept header (anything else draws PNG).
 RequestFormat = Literal[ImageFormat, "auto"]
-Tonemap = Literal["none", "reinhard", "aces"]
+Tonemap = Literal["none", "reinhard", "aces", "neutral"]
 # The tiers' own (model/tiers.py): a request names one, or auto.
 Quality = QualityName
 AntiAlias = AntiAliasName
@@ -120,7 +120,8 @@ class RenderFields(MaterialFields, SceneFields):
         None, description="Linear exposure multiplier before tone mapping, (0, 1000]."
     )
     tonemap: Tonemap | None = Field(
-        None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces'."
+        None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces', "
+                    "'neutral' (Khronos PBR Neutral: keeps hue)."
     )
     light_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None,

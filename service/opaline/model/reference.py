@@ -14,6 +14,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+# Re-exported (as X as X, for the type checker): the reference in one place.
+from opaline.model.display import srgb_decode as srgb_decode
+from opaline.model.display import srgb_encode as srgb_encode
+from opaline.model.display import tonemap as tonemap
 from opaline.model.microfacet import (  # noqa: F401 (re-exported: the reference in one place)
     EPS_DENOM,
     EPS_HALF,
@@ -201,26 +205,3 @@ def mdf_plot(material: Material, size: int, wavelengths: int = 0) -> FloatArray:
     """The paper's Figs. 2, 3, 6, 7: D over the projected half-vector disc, R G B."""
     hx, hy, hz, inside = mdf_plot_coords(size)
     return np.where(inside[..., None], mdf_rgb(material, hx, hy, hz, wavelengths), 0.0)
-
-
-# Display encoding (glsl/lib/display.glsl)
-
-
-def tonemap(x: npt.ArrayLike, mode: str) -> FloatArray:
-    x = np.maximum(x, 0.0)
-    if mode == "reinhard":
-        return x / (1.0 + x)
-    if mode == "aces":
-        # Narkowicz 2015 fit of the ACES filmic curve.
-        return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
-    return np.clip(x, 0.0, 1.0)
-
-
-def srgb_encode(x: npt.ArrayLike) -> FloatArray:
-    x = np.clip(x, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
-
-
-def srgb_decode(x: npt.ArrayLike) -> FloatArray:
-    x = np.clip(x, 0.0, 1.0)
-    return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))

@@ -28,7 +28,7 @@ BASE_DEFAULTS = {
     "transparent": False,
     "quality": "standard",
     "exposure": 1.0,
-    "tonemap": "aces",
+    "tonemap": "neutral",
 }
 
 
