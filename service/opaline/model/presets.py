@@ -89,8 +89,9 @@ class Preset(BaseModel):
     def scene_key(self) -> str:
         """Hash of everything that shapes the scene, for cache keys."""
         scene = self.model_dump(exclude={"defaults", "description", "figure"}, mode="json")
-        if scene["mesh_projection"] == "auto":
-            del scene["mesh_projection"]  # the keys of scenes from before the field stay
+        if self.geometry.kind != "file":
+            # It shapes only a user's mesh: the presets' own scenes keep their keys.
+            del scene["mesh_projection"]
         return hashlib.sha256(json.dumps(scene, sort_keys=True).encode()).hexdigest()[:16]
 
 

@@ -85,7 +85,8 @@ def bilinear(texels: np.ndarray, uv: np.ndarray) -> np.ndarray:
     i1, j1 = (i0 + 1) % width, (j0 + 1) % height
     top = texels[j0, i0] * (1 - fx) + texels[j0, i1] * fx
     bottom = texels[j1, i0] * (1 - fx) + texels[j1, i1] * fx
-    return top * (1 - fy) + bottom * fy
+    blended: np.ndarray = top * (1 - fy) + bottom * fy
+    return blended
 
 
 def sample(texels: np.ndarray, q: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
