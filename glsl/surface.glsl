@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_BACKDROP TONEMAP_NEUTRAL
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_BACKDROP TONEMAP_NEUTRAL
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -18,6 +18,9 @@ out vec3 v_object;
 out vec3 v_normal;
 out vec3 v_tangent;
 out vec2 v_uv;
+#ifdef OBJECT_PROJECTION
+out vec3 v_object_normal;
+#endif
 
 // Every variant compiles this code with other defines, and the all-features
 // baseline is compared with the scene's own variant pixel for pixel: all of them
@@ -31,6 +34,9 @@ void main() {
     v_normal = u_normal_matrix * in_normal;
     v_tangent = mat3(u_model) * in_tangent;
     v_uv = in_uv;
+#ifdef OBJECT_PROJECTION
+    v_object_normal = in_normal;
+#endif
     vec4 clip = u_view_proj * world;
     clip.xy += u_jitter * clip.w;
     gl_Position = clip;
@@ -79,6 +85,16 @@ uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickn
 #include "lib/waves.glsl"
 uniform mat3 u_normal_matrix;
 #endif
+#ifdef OBJECT_PROJECTION
+// A mesh without UVs takes the maps by object-space projection (lib/triplanar.glsl).
+#include "lib/triplanar.glsl"
+in vec3 v_object_normal;
+// xyz: the bounds' minimum corner, w: one over the longest side (one tile across it).
+uniform vec4 u_projection;
+#ifndef WAVES
+uniform mat3 u_normal_matrix;
+#endif
+#endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
 uniform vec3 u_backdrop;  // linear radiance that displays as the background colour
 #endif
@@ -110,7 +126,20 @@ void main() {
     t = mat3(u_model) * vec3(1.0, slope.x, 0.0);
 #endif
 #endif
-#ifdef NORMAL_MAP
+#ifdef OBJECT_PROJECTION
+    vec3 q = (v_object - u_projection.xyz) * u_projection.w;
+    vec3 object_n = safe_normalize(v_object_normal);
+    vec3 w = triplanar_weights(object_n);
+#endif
+#if defined(NORMAL_MAP) && defined(OBJECT_PROJECTION)
+    vec3 projected = triplanar_whiteout(
+        texture(u_normal_map, triplanar_uv_x(q), u_lod_bias).xyz,
+        texture(u_normal_map, triplanar_uv_y(q), u_lod_bias).xyz,
+        texture(u_normal_map, triplanar_uv_z(q), u_lod_bias).xyz, object_n, w);
+    if (dot(projected, projected) > 1e-12) {
+        n = u_normal_matrix * projected;
+    }
+#elif defined(NORMAL_MAP)
     vec3 mapped = texture(u_normal_map, v_uv, u_lod_bias).xyz;
     // A zero normal in the map keeps the geometric one.
     if (dot(mapped, mapped) > 1e-12) {
@@ -118,7 +147,12 @@ void main() {
     }
 #endif
     mat3 frame = shading_frame(n, t);
-#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
+#if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP) && defined(OBJECT_PROJECTION)
+    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+                        w.x * texture(u_thickness_map, triplanar_uv_x(q)).r
+                        + w.y * texture(u_thickness_map, triplanar_uv_y(q)).r
+                        + w.z * texture(u_thickness_map, triplanar_uv_z(q)).r);
+#elif defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
     float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
                         texture(u_thickness_map, v_uv).r);
 #else

@@ -15,6 +15,7 @@ import numpy as np
 
 from opaline.gl import physical
 from opaline.gl.culling import Culling
+from opaline.model import projection
 from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset, build_assets, build_thickness
 
@@ -120,6 +121,11 @@ class SceneGPU:
         # A user's mesh is framed by the camera: a sphere about its box's centre holding
         # every vertex (tighter than the box's corners, so a torus fills the frame).
         self.bounds = bounding_sphere(mesh.positions) if is_mesh(preset) else None
+        # A user's mesh without UVs takes the maps in object space: (origin, scale).
+        self.projection: tuple[float, float, float, float] | None = None
+        if is_mesh(preset) and projection.projects(preset.mesh_projection, mesh.uvs):
+            origin, scale = projection.frame(mesh.positions)
+            self.projection = (*origin, scale)
         self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
         self.normal_map = None

@@ -83,3 +83,37 @@ class Probes:
                 tex.release()
         # Case i sits at GL row i // width; read() gave image order (top row first).
         return image[::-1].reshape(-1, 4)[:count, :3]
+
+    def triplanar(self, q: np.ndarray, n: np.ndarray, texels: np.ndarray) -> np.ndarray:
+        """glsl/lib/triplanar.glsl for each (projection coordinate, object normal) case, on
+        an RGBA float map (row 0 at v = 0): (count, 4), blended normal and scalar."""
+        res = self.resources
+        res.gl.make_current()
+        count = len(q)
+        width = min(count, 256)
+        height = -(-count // width)
+        program = res.programs.get("triplanar_probe.glsl", {})
+        textures = []
+        try:
+            for unit, (name, data) in enumerate((("u_position", q), ("u_normal", n))):
+                grid = np.zeros((height * width, 4), dtype="f4")
+                grid[:count, :3] = data
+                textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
+                textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
+                textures[-1].use(location=unit)
+                program[name].value = unit
+            rows, cols = texels.shape[:2]
+            textures.append(res.ctx.texture((cols, rows), 4, texels.astype("f4").tobytes(),
+                                            dtype="f4"))
+            textures[-1].repeat_x = textures[-1].repeat_y = True
+            textures[-1].use(location=2)
+            program["u_map"].value = 2
+            targets = res.targets((width, height))
+            targets.display_fbo.use()
+            res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+            res.fullscreen(program)
+            image = read_float(targets.display_fbo, (width, height))
+        finally:
+            for tex in textures:
+                tex.release()
+        return image[::-1].reshape(-1, 4)[:count]

@@ -102,6 +102,8 @@ class SurfacePass:
                  where: Placement) -> moderngl.Program:
         """The surface variant for this job and plan, its uniforms set and textures bound."""
         defines = material_program.surface_defines(job, preset)
+        if scene.projection is not None:
+            defines["OBJECT_PROJECTION"] = True
         if plan.display:
             defines.update(DISPLAY=True, **tonemap_defines(job))
         defines.update(dict.fromkeys(plan.forced, True))
@@ -120,6 +122,7 @@ class SurfacePass:
             "u_aa_scale": plan.samples.aa_scale,
             "u_exposure": job.exposure,
             **heightfield.uniforms(preset),
+            "u_projection": scene.projection or (0.0, 0.0, 0.0, 1.0),
         })
         values.update(self._textures(job, preset, scene, plan, defines))
         uniforms.apply(program, values)

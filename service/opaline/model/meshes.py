@@ -27,16 +27,23 @@ def file_digest(path: Path) -> str:
 
 def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max_triangles: int) -> Preset:
     """``base`` drawing the mesh at ``path``: its lights, background and
-    defaults, the camera framed on the mesh by the renderer, no normal map (the
-    mesh's UVs were not made for the preset's map)."""
+    defaults and maps, the camera framed on the mesh by the renderer (the maps projected
+    in object space where the mesh has no UVs, or where the preset asks:
+    ``opaline.model.projection``)."""
     # The generator's arguments (scene.meshfile.mesh_file's), of their several types.
     args: dict[str, Any] = {"kind": MESH_KIND, "path": str(path), "digest": digest,
-                            "tangent_field": request.tangent_field or "auto",
+                            "tangent_field": request.tangent_field or _default_field(base),
                             "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
                             "max_triangles": max_triangles}
     return base.model_copy(update={"name": f"mesh-{digest[:12]}",
-                                   "geometry": Generator(**args), "normal_map": None,
+                                   "geometry": Generator(**args),
                                    "tangents": "uv", "rotation_deg": (0.0, 0.0, 0.0)})
+
+
+def _default_field(base: Preset) -> str:
+    """A preset drawn with concentric tangents (the CD's tracks) gives a mesh concentric
+    ones about ``tangent_axis``, UVs or not; the others follow the mesh's UVs."""
+    return "concentric" if base.tangents == "concentric" else "auto"
 
 
 def is_mesh(preset: Preset) -> bool:

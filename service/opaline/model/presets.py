@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from opaline.errors import PublicError
 from opaline.model.material import Unit
 from opaline.model.params import STRICT, RenderFields, describe_errors
+from opaline.model.projection import MeshProjection
 from opaline.resources import presets_dir
 from opaline.scene import geometry, meshfile, normalmaps, thickness
 
@@ -73,6 +74,9 @@ class Preset(BaseModel):
     normal_map: Generator | None = None
     # Film thickness in [0, 1] over uv, mapped to [film_thickness_min, max] (thin film only).
     thickness_map: Generator | None = None
+    # How a user's mesh takes the maps: its UVs where it has them ("auto"), or always by
+    # object-space projection ("object": maps whose look is their scale, such as nacre).
+    mesh_projection: MeshProjection = "auto"
     # A free film (soap bubble): the background shows through what the film does not reflect.
     transmission: bool = False
     rotation_deg: Vec3 = (0.0, 0.0, 0.0)
@@ -85,6 +89,9 @@ class Preset(BaseModel):
     def scene_key(self) -> str:
         """Hash of everything that shapes the scene, for cache keys."""
         scene = self.model_dump(exclude={"defaults", "description", "figure"}, mode="json")
+        if self.geometry.kind != "file":
+            # It shapes only a user's mesh: the presets' own scenes keep their keys.
+            del scene["mesh_projection"]
         return hashlib.sha256(json.dumps(scene, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -125,16 +132,27 @@ def _map_args(generator: Generator) -> dict[str, Any]:
 def build_assets(preset: Preset) -> tuple[Any, Any]:
     """The preset's mesh and normal map (or None), generated once per scene."""
     if preset.geometry.kind == "file":
-        # A user's mesh: loaded (and bounded in number) by meshfile, never kept here.
-        return meshfile.mesh_file(**preset.geometry.args), None
+        # A user's mesh: loaded (and bounded in number) by meshfile, never kept here; the
+        # preset's normal map, projected onto it (model.projection), is.
+        return meshfile.mesh_file(**preset.geometry.args), _normal_map(preset.normal_map)
     key = preset.scene_key()
     if key not in _assets:
         mesh = geometry.build(preset.geometry.kind, **preset.geometry.args)
-        normal_map = None
-        if preset.normal_map is not None:
-            normal_map = normalmaps.build(preset.normal_map.kind, **_map_args(preset.normal_map))
-        _assets[key] = (mesh, normal_map)
+        _assets[key] = (mesh, _normal_map(preset.normal_map))
     return _assets[key]
+
+
+_normal_maps: dict[str, Any] = {}
+
+
+def _normal_map(generator: Generator | None) -> Any:
+    """A normal map (or None), generated once per generator: every mesh shares its preset's."""
+    if generator is None:
+        return None
+    key = json.dumps(generator.model_dump(mode="json"), sort_keys=True)
+    if key not in _normal_maps:
+        _normal_maps[key] = normalmaps.build(generator.kind, **_map_args(generator))
+    return _normal_maps[key]
 
 
 _thickness: dict[str, Any] = {}

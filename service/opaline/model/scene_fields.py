@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from opaline.scene.environments import BUILTIN
 
@@ -39,6 +39,14 @@ class SceneFields(BaseModel):
     tangent_axis: Finite3 | None = Field(
         None, description="Axis of the concentric field, or direction of the projected one "
                           "(default 0,1,0).")
+
+    @field_validator("tangent_axis")
+    @classmethod
+    def _direction(cls, axis: Finite3 | None) -> Finite3 | None:
+        # Refused here, a 422 naming the field, not when a worker builds the field.
+        if axis is not None and sum(c * c for c in axis) < 1e-18:
+            raise ValueError("must be a non-zero direction")
+        return axis
     camera_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Camera azimuth in degrees around the target's up axis "
                           "(0: +x, 90: +z), -360 … 360 (default: the preset's view).")
