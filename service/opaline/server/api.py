@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import asyncio
 import os
-from collections import OrderedDict
 from contextlib import asynccontextmanager
 from functools import partial
 from pathlib import Path
@@ -44,6 +43,8 @@ from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness, TierInfo
+from opaline.server.statestore import open_state
+from opaline.server.turntable_jobs import Turntables
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.factory import RendererFactory
@@ -144,6 +145,7 @@ async def lifespan(app: FastAPI):
     try:
         yield
     finally:
+        await app.state.turntables.stop()  # before the workers: stopped, not failed
         await asyncio.to_thread(app.state.pool.stop)
 
 
@@ -201,8 +203,9 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
-    app.state.meshes = MeshStore(settings)
-    app.state.turntables = OrderedDict()  # turntable_routes.Turntable by id, latest last
+    state = open_state(settings)
+    app.state.meshes = MeshStore(settings, state)
+    app.state.turntables = Turntables(state, settings)
     app.state.turntable_lanes = asyncio.Semaphore(settings.workers)
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
                        on_reject=partial(metrics.reject, "too_large"),
