@@ -9,9 +9,10 @@ import time
 
 import pytest
 
+from opaline.server.api import open_state
 from opaline.server.meshstore import MeshStore, UnknownMesh
 from opaline.server.redisstate import RedisState, public_address
-from opaline.server.statestore import LocalState, StoreUnavailable, open_state
+from opaline.server.statestore import LocalState, StoreUnavailable
 from opaline.server.turntable_jobs import StoredFailure, failure_of
 from opaline.settings import Settings
 from opaline.workers.errors import DeadlineExceeded

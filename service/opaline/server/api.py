@@ -43,7 +43,7 @@ from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness, TierInfo
-from opaline.server.statestore import open_state
+from opaline.server.statestore import LocalState, StateStore
 from opaline.server.turntable_jobs import Turntables
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
@@ -156,6 +156,16 @@ def renderer_for(settings: Settings) -> RendererFactory:
                            scene_bytes=settings.worker_scene_mb * mib,
                            target_bytes=settings.worker_target_mb * mib,
                            environments_dir=settings.environments_dir)
+
+
+def open_state(settings: Settings) -> StateStore:
+    """The store ``settings.state_url`` names: this process's memory when unset."""
+    if settings.state_url is None:
+        return LocalState(settings.mesh_store_bytes)
+    from opaline.server.redisstate import RedisState  # the redis package only when used
+
+    return RedisState(settings.state_url, settings.mesh_store_bytes,
+                      timeout_s=settings.state_timeout_s)
 
 
 def document(app: FastAPI, *models: type[BaseModel]) -> None:

@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from opaline.errors import PublicError
-from opaline.settings import Settings
 
 KEPT = 64  # records (and byte values) LocalState keeps, the oldest forgotten first
 
@@ -100,13 +99,3 @@ class LocalState:
         while len(self._records) > KEPT:  # a running turntable forgotten here stops itself
             self._records.popitem(last=False)
         return expect + 1
-
-
-def open_state(settings: Settings) -> StateStore:
-    """The store ``settings.state_url`` names: this process's memory when unset."""
-    if settings.state_url is None:
-        return LocalState(settings.mesh_store_bytes)
-    from opaline.server.redisstate import RedisState  # the redis package only when used
-
-    return RedisState(settings.state_url, settings.mesh_store_bytes,
-                      timeout_s=settings.state_timeout_s)
