@@ -103,7 +103,7 @@ class RedisState:
             self._call(self.client.set, PREFIX + key, data, px=max(1, int(ttl_s * 1000)))
 
     def get(self, key: str) -> bytes | None:
-        data = self._call(self.client.get, PREFIX + key)
+        data: bytes | None = self._call(self.client.get, PREFIX + key)
         if data is not None:
             self.touch(key)
         return data

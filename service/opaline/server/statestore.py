@@ -20,10 +20,11 @@ from __future__ import annotations
 import time
 from collections import OrderedDict
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, TypeVar
 
 from opaline.errors import PublicError
 
+V = TypeVar("V")
 KEPT = 64  # records (and byte values) LocalState keeps, the oldest forgotten first
 
 
@@ -68,7 +69,7 @@ class LocalState:
         self._records: OrderedDict[str, tuple[Record, float]] = OrderedDict()
 
     @staticmethod
-    def _live(found: tuple[Any, float] | None) -> Any:
+    def _live(found: tuple[V, float] | None) -> V | None:
         return None if found is None or found[1] < time.monotonic() else found[0]
 
     def put(self, key: str, data: bytes, ttl_s: float | None = None) -> None:

@@ -101,8 +101,8 @@ class Turntables:
     def orphaned(self, record: Record) -> bool:
         """Running, but owned by another process that has let its lease run out."""
         value = record.value
-        return (value["state"] == "running" and value["owner"] != self.owner
-                and value["lease_until"] < time.time())
+        return bool(value["state"] == "running" and value["owner"] != self.owner
+                    and value["lease_until"] < time.time())
 
     async def claim(self, value: dict[str, Any], expect: int) -> Job | None:
         """Write ``value`` as this replica's job if the record is still at ``expect``."""

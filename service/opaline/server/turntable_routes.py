@@ -69,14 +69,16 @@ BODY = {"requestBody": {"required": True, "content": {
 async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep,
                          shared: LanesDep) -> TurntableStatus:
     raw = await request.body()
-    body, _, key = plan(svc, raw)
+    planned = plan(svc, raw)
+    body, _, key = planned
     record = await found.read(key)
     while record is None or record.value["state"] == "failed" or found.orphaned(record):
         if len(found.running) >= svc.settings.max_turntables:
             raise Busy(f"{len(found.running)} turntables are rendering, the most this service "
                        "runs at once; retry later", retry_after_s=svc.settings.deadline_s)
         value = new_job(key, raw.decode(), body.frames, body.animation)
-        record = (await start(svc, found, value, record.version if record else 0, shared)
+        record = (await start(svc, found, value, record.version if record else 0, shared,
+                              planned)
                   or await found.read(key))  # or another replica started it first
     return status_of(record.value)
 

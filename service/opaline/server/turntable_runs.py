@@ -104,10 +104,11 @@ def plan(svc: Service, raw: bytes) -> tuple[TurntableRequest, Tasks, str]:
 
 
 async def start(svc: Service, found: Turntables, value: dict[str, Any], expect: int,
-                shared: asyncio.Semaphore) -> Record | None:
+                shared: asyncio.Semaphore,
+                planned: tuple[TurntableRequest, Tasks, str] | None = None) -> Record | None:
     """Run the job ``value`` here if its record is still at version ``expect``: its record
-    as written, or None if another replica wrote first."""
-    body, tasks, _ = plan(svc, value["body"].encode())
+    as written, or None if another replica wrote first. ``planned``: its ``plan``, if made."""
+    body, tasks, _ = planned or plan(svc, value["body"].encode())
     job = await found.claim(value, expect)
     if job is None:
         return None
