@@ -145,7 +145,18 @@ def test_a_batch_fans_out_over_the_replicas(deployment, tmp_path):
     made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
     assert summary["counts"]["rendered"] == 12 and sum(made) == 12
     assert min(made) >= 3, made  # round robin: neither replica idle
-    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}")
+    # Again, into another folder: the client GETs canonical URLs, which nginx keeps.
+    hits = proxy.log().count(" cache=HIT ")
+    again = run_batch([folder], Options(out=tmp_path / "again", jobs=4, server=proxy.base,
+                                        quiet=True))
+    remade = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    assert again["counts"]["rendered"] == 12 and remade == made, remade
+    deadline = time.monotonic() + 1.0
+    while proxy.log().count(" cache=HIT ") < hits + 12 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert proxy.log().count(" cache=HIT ") == hits + 12
+    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}; "
+          "run again: 12 nginx HITs, no render")
 
 
 def test_a_mesh_uploaded_through_the_proxy_renders_on_every_replica(deployment):
