@@ -13,6 +13,7 @@ import os
 import re
 import subprocess
 from pathlib import Path
+from urllib.parse import urlsplit
 
 import pytest
 import yaml
@@ -62,7 +63,8 @@ def test_every_manifest_is_valid_for_a_current_kubernetes():
     for doc in documents():
         kubernetes_validate.validate(doc, KUBERNETES, strict=True)
         kinds.add(doc["kind"])
-    assert kinds == {"Deployment", "Service", "PodDisruptionBudget", "HorizontalPodAutoscaler"}
+    assert kinds == {"Deployment", "Service", "PodDisruptionBudget", "HorizontalPodAutoscaler",
+                     "PersistentVolumeClaim"}
 
 
 def test_the_validator_catches_a_misspelt_field():
@@ -108,15 +110,41 @@ def test_users_are_the_images_numeric_non_root_users():
 
 
 def test_services_budget_and_autoscaler_select_the_deployments():
-    for name in ("opaline", "opaline-cache"):
+    for name in ("opaline", "opaline-cache", "opaline-state"):
         labels = find("Deployment", name)["spec"]["template"]["metadata"]["labels"]
         selector = find("Service", name)["spec"]["selector"]
         assert selector.items() <= labels.items()
+    state = find("Deployment", "opaline-state")["spec"]["template"]["metadata"]["labels"]
+    assert find("PodDisruptionBudget", "opaline-state")["spec"]["selector"]["matchLabels"] == state
     labels = find("Deployment", "opaline")["spec"]["template"]["metadata"]["labels"]
     assert find("PodDisruptionBudget", "opaline")["spec"]["selector"]["matchLabels"] == labels
     target = find("HorizontalPodAutoscaler", "opaline")["spec"]["scaleTargetRef"]
     assert (target["kind"], target["name"]) == ("Deployment", "opaline")
     assert find("HorizontalPodAutoscaler", "opaline")["spec"]["minReplicas"] >= 2
+
+
+def test_the_replicas_share_the_store_and_it_keeps_what_they_wrote():
+    """OPALINE_STATE_URL names the store's Service and port; Redis holds the mesh budget
+    without evicting anything itself (Opaline's own LRU does), in an append-only file on
+    its volume, and the replicas' /tmp holds their copies of the meshes."""
+    deployment = find("Deployment", "opaline")
+    settings = settings_of(deployment)
+    url = urlsplit(settings.state_url)
+    service = find("Service", url.hostname)
+    assert url.port == service["spec"]["ports"][0]["port"]
+    redis = find("Deployment", url.hostname)
+    args = container(redis)["args"]
+    option = dict(zip(args[::2], args[1::2], strict=True))
+    assert option["--maxmemory-policy"] == "noeviction" and option["--appendonly"] == "yes"
+    assert int(option["--maxmemory"].removesuffix("gb")) * 1024 * MIB > settings.mesh_store_bytes
+    assert mebibytes(container(redis)["resources"]["limits"]["memory"]) * MIB > 1024 * MIB
+    mount = next(m for m in container(redis)["volumeMounts"] if m["mountPath"] == option["--dir"])
+    volume = next(v for v in redis["spec"]["template"]["spec"]["volumes"]
+                  if v["name"] == mount["name"])
+    assert find("PersistentVolumeClaim", volume["persistentVolumeClaim"]["claimName"])
+    tmp = next(v for v in deployment["spec"]["template"]["spec"]["volumes"] if v["name"] == "tmp")
+    room = mebibytes(tmp["emptyDir"]["sizeLimit"]) * MIB
+    assert room >= settings.mesh_store_bytes + settings.mesh_max_bytes
 
 
 def seconds(directive: str, text: str) -> float:

@@ -3,7 +3,10 @@
 Shows, with the figures printed (pytest -s): a miss on one replica is a hit for
 requests that the balancer routes to the other; 50 concurrent equal requests
 render once across both replicas; killing a replica mid-run loses no request
-the other can serve. Bounded: small images, about 30 s in all on 2 cores.
+the other can serve. The replicas share a real Redis (OPALINE_STATE_URL): a mesh
+uploaded through the proxy renders on both, a turntable answers from either, and one
+whose replica is killed mid-run is finished by the other. Bounded: small images, about
+40 s in all on 2 cores.
 """
 
 from __future__ import annotations
@@ -19,15 +22,18 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 import httpx
 import pytest
 
+from mesh_helpers import mesh_bytes
 from opaline.batch.run import Options, run_batch
 from opaline.model.params import RenderRequest
 from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, prepare
 from opaline.server.localproxy import LocalProxy, nginx_binary
 from opaline.server.localserver import LocalServer
+from redis_helpers import LocalRedis, need_redis
 
 pytestmark = pytest.mark.gl
-REPLICA_ENV = {"OPALINE_CALIBRATE": "0", "OPALINE_QUEUE_SIZE": "64", "OPALINE_DEADLINE_S": "30"}
+REPLICA_ENV = {"OPALINE_CALIBRATE": "0", "OPALINE_QUEUE_SIZE": "64", "OPALINE_DEADLINE_S": "30",
+               "OPALINE_STATE_LEASE_S": "2"}
 PRESET = "cd-rom"  # the warm-up renders "sphere": counting cd-rom renders counts ours only
 
 
@@ -68,9 +74,17 @@ def need_nginx() -> None:
 
 
 @pytest.fixture(scope="module")
-def deployment():
+def store():
+    need_redis()
+    with LocalRedis() as redis:
+        yield redis
+
+
+@pytest.fixture(scope="module")
+def deployment(store):
     need_nginx()
-    with (LocalServer(env=REPLICA_ENV) as a, LocalServer(env=REPLICA_ENV) as b,
+    env = {**REPLICA_ENV, "OPALINE_STATE_URL": store.url}
+    with (LocalServer(env=env) as a, LocalServer(env=env) as b,
           LocalProxy([a.base, b.base]) as proxy,
           httpx.Client(base_url=proxy.base, trust_env=False, timeout=60,
                        limits=httpx.Limits(max_connections=64)) as client):
@@ -131,7 +145,66 @@ def test_a_batch_fans_out_over_the_replicas(deployment, tmp_path):
     made = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
     assert summary["counts"]["rendered"] == 12 and sum(made) == 12
     assert min(made) >= 3, made  # round robin: neither replica idle
-    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}")
+    # Again, into another folder: the client GETs canonical URLs, which nginx keeps.
+    hits = proxy.log().count(" cache=HIT ")
+    again = run_batch([folder], Options(out=tmp_path / "again", jobs=4, server=proxy.base,
+                                        quiet=True))
+    remade = [renders(r) - b for r, b in zip(replicas, before, strict=True)]
+    assert again["counts"]["rendered"] == 12 and remade == made, remade
+    deadline = time.monotonic() + 1.0
+    while proxy.log().count(" cache=HIT ") < hits + 12 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert proxy.log().count(" cache=HIT ") == hits + 12
+    print(f"\nbatch --server via nginx: 12 materials, renders per replica {made}; "
+          "run again: 12 nginx HITs, no render")
+
+
+def test_a_mesh_uploaded_through_the_proxy_renders_on_every_replica(deployment):
+    replicas, proxy, client = deployment
+    upload = client.post("/v1/meshes", content=mesh_bytes("stl"))
+    assert upload.status_code == 201, upload.text
+    paths = [f"/v1/render?preset={PRESET}&mesh={upload.json()['id']}&mu_f={1 + i / 9}"
+             "&width=48&height=48&quality=draft" for i in range(8)]
+    statuses = [client.get(path).status_code for path in paths]  # each a miss: round robin
+    assert statuses == [200] * 8, statuses
+    routed = {upstream(log_lines(proxy, path)[0]) for path in paths}
+    assert routed == {r.base.removeprefix("http://") for r in replicas}
+    print(f"\nshared meshes: 8 renders of an uploaded mesh, all 200, via {sorted(routed)}")
+
+
+def poll_until_done(clients: list[httpx.Client], path: str) -> list[dict]:
+    """GET ``path`` from each client in turn until the turntable is no longer running."""
+    seen: list[dict] = []
+    deadline = time.monotonic() + 60
+    while not seen or seen[-1]["state"] == "running":
+        assert time.monotonic() < deadline, seen[-1:]
+        for client in clients:
+            answer = client.get(path)
+            assert answer.status_code == 200, answer.text  # never 404, whoever answers
+            seen.append(answer.json())
+        time.sleep(0.05)
+    return seen
+
+
+def test_a_turntable_answers_from_either_replica(deployment):
+    replicas, proxy, client = deployment
+    body = {"preset": PRESET, "frames": 6, "width": 48, "height": 48, "quality": "draft",
+            "mu_f": 9.5}
+    started = client.post("/v1/turntables", json=body)
+    assert started.status_code == 202, started.text
+    path = f"/v1/turntables/{started.json()['id']}"
+    direct = [httpx.Client(base_url=r.base, trust_env=False, timeout=30) for r in replicas]
+    try:
+        seen = poll_until_done([client, *direct], path)
+        assert seen[-1]["state"] == "done" and seen[-1]["done"] == 6, seen[-1]
+        results = [c.get(path + "/result") for c in (client, *direct)]
+    finally:
+        for c in direct:
+            c.close()
+    assert [r.status_code for r in results] == [200] * 3
+    assert len({r.content for r in results}) == 1
+    print(f"\nshared turntables: {len(seen)} polls via the proxy and both replicas, all 200; "
+          "the result fetched 200 from each")
 
 
 def test_killing_a_replica_loses_no_request(deployment):
@@ -173,6 +246,32 @@ def test_killing_a_replica_loses_no_request(deployment):
     print(f"\nfail-over: replica killed after {killed_after} of {len(targets)} answers; "
           f"all {len(targets)} answered 200: {retried} retried on the survivor by nginx, "
           f"{len(cut)} cut off mid-answer and asked again by the client")
+
+
+def test_a_turntable_outlives_the_replica_running_it(deployment, store):
+    """A third replica takes a turntable and is killed mid-run (after the test above, only
+    the second replica is left behind the proxy): once its lease runs out, the survivor
+    renders the job again from its request. Every poll answers 200, the result comes."""
+    replicas, proxy, client = deployment
+    survivor = replicas[1]
+    before = renders(survivor)
+    body = {"preset": PRESET, "frames": 24, "width": 96, "height": 96, "mu_f": 3.3}
+    with (LocalServer(env={**REPLICA_ENV, "OPALINE_STATE_URL": store.url}) as doomed,
+          httpx.Client(base_url=doomed.base, trust_env=False, timeout=30) as direct):
+        started = direct.post("/v1/turntables", json=body)
+        assert started.status_code == 202, started.text
+        path = f"/v1/turntables/{started.json()['id']}"
+        while direct.get(path).json()["done"] < 2:
+            time.sleep(0.01)
+        doomed.proc.send_signal(signal.SIGKILL)
+        doomed.proc.wait(10)
+    seen = poll_until_done([client], path)
+    assert seen[-1]["state"] == "done", seen[-1]
+    result = client.get(path + "/result")
+    assert result.status_code == 200 and len(result.content) > 0
+    assert renders(survivor) - before >= 24 - 2  # it rendered the frames again
+    print(f"\ntake-over: replica killed mid-turntable; {len(seen)} polls via the proxy all "
+          f"200, the survivor finished it ({renders(survivor) - before:.0f} frames)")
 
 
 class VaryingUpstream(BaseHTTPRequestHandler):

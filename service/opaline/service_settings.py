@@ -113,6 +113,19 @@ class Settings(BaseSettings):
         description="Bytes of uploaded meshes kept on disk; the least recently used go first.")
     mesh_store_dir: Path | None = Field(
         None, description="Where uploaded meshes are kept (default: a temporary folder).")
+    state_url: str | None = Field(
+        None, pattern=r"^rediss?://",
+        description="Where uploaded meshes and turntable jobs live. Unset: this process "
+                    "(meshes in OPALINE_MESH_STORE_DIR, turntables in memory); "
+                    "redis://host:port/db: a Redis every replica shares (docs/deployment.md).")
+    state_timeout_s: float = Field(
+        1.0, gt=0, le=60, description="A state store call that takes longer answers 503.")
+    state_lease_s: float = Field(
+        10.0, gt=0, le=600,
+        description="A turntable whose replica has not renewed its lease for this long is "
+                    "continued by the replica that next answers for it.")
+    turntable_keep_s: int = Field(
+        3600, ge=1, description="How long a turntable's status and result are kept.")
     meshes_dir: Path | None = Field(
         None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
     environments_dir: Path | None = Field(

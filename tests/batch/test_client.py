@@ -11,16 +11,19 @@ import time
 from contextlib import contextmanager
 from http.server import BaseHTTPRequestHandler, HTTPServer, ThreadingHTTPServer
 from pathlib import Path
+from urllib.parse import parse_qsl, urlsplit
 
 import numpy as np
 import pytest
 from PIL import Image
 from pydantic import ValidationError
 
-from opaline.batch.client import RemoteError, RemoteRenderer
+from opaline.batch.client import NAMING, RemoteError, RemoteRenderer
 from opaline.cli.main import main
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.presets import UnknownPreset, get_preset
+from opaline.pipeline.prepare import prepare
+from opaline.server.canonical import CanonicalQuery
 
 SMALL = {"width": 64, "height": 64, "quality": "draft"}
 
@@ -42,6 +45,7 @@ class FakeOpaline:
         self.render = render
         self.delay = delay
         self.bodies: list[dict] = []
+        self.asked: list[str] = []  # "GET /v1/render?…" or "POST /v1/render"
         self.statuses: list[int] = []
         self.in_flight = self.max_in_flight = 0
         self.lock = threading.Lock()
@@ -64,14 +68,21 @@ class FakeOpaline:
 
 def handler_for(fake: FakeOpaline) -> type[BaseHTTPRequestHandler]:
     class Handler(BaseHTTPRequestHandler):
-        def do_POST(self) -> None:  # noqa: N802 (http.server's naming)
+        def do_GET(self) -> None:  # noqa: N802 (http.server's naming)
+            query = CanonicalQuery.model_validate(dict(parse_qsl(urlsplit(self.path).query)))
+            self.answer(query.request().model_dump(mode="json", exclude_none=True))
+
+        def do_POST(self) -> None:  # noqa: N802
+            self.answer(json.loads(self.rfile.read(int(self.headers["Content-Length"]))))
+
+        def answer(self, body: dict) -> None:
             with fake.lock:
                 fake.in_flight += 1
                 fake.max_in_flight = max(fake.max_in_flight, fake.in_flight)
+                fake.asked.append(f"{self.command} {self.path}")
             try:
-                body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
                 time.sleep(fake.delay)
-                if self.path != "/v1/render":
+                if urlsplit(self.path).path != "/v1/render":
                     status, headers, data = 404, {}, b'{"detail": "not found"}'
                 else:
                     status, headers, data = fake.answer(body)
@@ -118,13 +129,23 @@ def request(**fields) -> RenderRequest:
     return RenderRequest(**{**SMALL, **fields})
 
 
-def test_body_is_the_request_without_unset_fields():
-    """The client posts exactly RenderRequest.model_dump(exclude_none=True) to /v1/render."""
+def test_a_request_is_asked_at_its_canonical_url_and_a_dict_posted_as_is():
+    """A RenderRequest is a GET of the URL the service names in Content-Location (what a
+    shared cache keeps); a dict, or a request naming a mesh, is POSTed unchanged."""
     fake = FakeOpaline()
+    asked = request(preset="cd-rom", mu_f=6, albedo=(0.1, 0.2, 0.3))
+    meshed = request(preset="cd-rom", mesh="0" * 32)
     with serving(fake) as url, RemoteRenderer(url) as remote:
-        data = remote.render(request(preset="cd-rom", mu_f=6, albedo=(0.1, 0.2, 0.3)))
-    expected = request(preset="cd-rom", mu_f=6, albedo=(0.1, 0.2, 0.3))
-    assert fake.bodies == [expected.model_dump(mode="json", exclude_none=True)]
+        data = remote.render(asked)
+        remote.render(asked.model_dump(mode="json", exclude_none=True))
+        remote.render(meshed)
+    assert fake.asked == [f"GET {prepare(asked, NAMING).url()}", "POST /v1/render",
+                          "POST /v1/render"]
+    assert fake.bodies[0] == CanonicalQuery.model_validate(
+        dict(parse_qsl(urlsplit(fake.asked[0]).query))).request().model_dump(
+            mode="json", exclude_none=True)
+    assert fake.bodies[1] == asked.model_dump(mode="json", exclude_none=True)
+    assert fake.bodies[2] == meshed.model_dump(mode="json", exclude_none=True)
     assert data == canned_png(fake.bodies[0])
 
 

@@ -18,7 +18,8 @@ from opaline.model.turntable import TurntableRequest, frame_jobs
 from opaline.output.animation import ANIMATION_FORMATS, decode, encode
 from opaline.server.api import create_app
 from opaline.server.service import Service
-from opaline.server.turntable_routes import Turntable, patiently
+from opaline.server.turntable_jobs import failure_of, new_job
+from opaline.server.turntable_runs import patiently
 from opaline.settings import Settings
 from opaline.workers.errors import DeadlineExceeded, Overloaded
 
@@ -99,16 +100,22 @@ def test_http_turntable_with_progress(backend):
             assert unknown.status_code == 404 and unknown.json()["error"] == "unknown_turntable"
         # one running turntable is the cap here: another is 429 busy, the same one is not
         found = client.app.state.turntables
-        found["x"] = Turntable("x", 8, "webp")
+        x = {**new_job("x", "{}", 8, "webp"), "owner": found.owner, "lease_until": 1e12}
+        found.store.put_record("turntable:x", x, 0, 60)
+        found.running["x"] = (None, None)  # as if this replica were rendering it
         busy = client.post("/v1/turntables", json={"preset": "sphere", "frames": 2,
                                                    "width": 32, "height": 32})
         assert busy.status_code == 429 and busy.json()["error"] == "busy", busy.text
         assert int(busy.headers["retry-after"]) >= 1
+        del found.running["x"]
         rendering = client.get("/v1/turntables/x/result")
         assert rendering.status_code == 409 and rendering.json()["error"] == "rendering"
-        found["x"].state, found["x"].failure = "failed", DeadlineExceeded("no image in 2 s")
+        failure = failure_of(DeadlineExceeded("no image in 2 s"))
+        found.store.put_record("turntable:x", {**x, "state": "failed", "failure": failure}, 1, 60)
         failed = client.get("/v1/turntables/x/result")
-        assert failed.status_code == 503 and failed.json()["error"] == "deadline"
+        assert failed.status_code == 503 and failed.json() == {
+            "error": "deadline", "detail": ["no image in 2 s; retry later"]}
+        assert int(failed.headers["retry-after"]) >= 1
 
 
 class FullQueue:

@@ -1,9 +1,14 @@
-"""HTTP client for a running Opaline: ``POST {url}/v1/render``, with bounded retries.
+"""HTTP client for a running Opaline: ``GET`` each image's canonical URL, with bounded
+retries.
 
-The body is ``RenderRequest.model_dump(exclude_none=True)``; the answer is the
-image bytes. A 4xx carries ``{"detail": "message"}`` or ``{"detail": [...]}``
-and is final. A 503 (queue full; ``Retry-After`` honoured) or a connection
-error is retried with exponential backoff, at most ``retries`` times.
+A ``RenderRequest`` is asked at its canonical GET URL (``Prepared.url()``: what the
+service names in Content-Location), so a shared cache in front of the service
+(deploy/nginx) answers a repeated run without a render; a request only the service
+can name (a mesh it stores, an environment file of its folder) and a plain dict are
+POSTed as the body ``model_dump(exclude_none=True)``. The answer is the image bytes.
+A 4xx carries ``{"detail": "message"}`` or ``{"detail": [...]}`` and is final. A 503
+(queue full; ``Retry-After`` honoured) or a connection error is retried with
+exponential backoff, at most ``retries`` times.
 One ``RemoteRenderer`` may be shared by threads (httpx.Client is thread-safe).
 """
 
@@ -16,9 +21,24 @@ from typing import Any
 
 import httpx
 
+from opaline.errors import PublicError
 from opaline.model.params import RenderRequest
+from opaline.pipeline.limits import Limits
+from opaline.pipeline.prepare import Context, prepare
 
 RETRY_STATUSES = {503}
+# No limits (the service applies its own) and no meshes: those only the service can name.
+NAMING = Context(Limits(cost_budget=None), lambda request, preset: preset)
+
+
+def canonical_path(request: RenderRequest) -> str | None:
+    """``/v1/render?…&rev=…`` for ``request``, or None where only the service can name it."""
+    if request.mesh is not None:
+        return None
+    try:
+        return prepare(request, NAMING).url()
+    except (PublicError, ValueError):  # an environment file of the service's folder ...
+        return None
 
 
 class RemoteError(RuntimeError):
@@ -55,7 +75,8 @@ class RemoteRenderer:
                  client: httpx.Client | None = None) -> None:
         if retries < 0:
             raise ValueError(f"retries={retries} must be 0 or more")
-        self.url = url.rstrip("/") + "/v1/render"
+        self.base = url.rstrip("/")
+        self.url = self.base + "/v1/render"
         self.retries = retries
         self.backoff = backoff
         self.max_delay = max_delay
@@ -75,6 +96,7 @@ class RemoteRenderer:
 
     def render(self, request: RenderRequest | dict[str, Any]) -> bytes:
         """The image bytes; raises RemoteError once the server refuses or retries run out."""
+        path = canonical_path(request) if isinstance(request, RenderRequest) else None
         if isinstance(request, RenderRequest):
             body = request.model_dump(mode="json", exclude_none=True)
         else:
@@ -84,7 +106,8 @@ class RemoteRenderer:
             with self._lock:
                 self.attempts += 1
             try:
-                response = self.client.post(self.url, json=body)
+                response = (self.client.get(self.base + path) if path is not None
+                            else self.client.post(self.url, json=body))
             except httpx.TransportError as exc:
                 if last or isinstance(exc, httpx.UnsupportedProtocol):
                     raise RemoteError(f"{self.url}: {type(exc).__name__}: {exc} "

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import asyncio
 import os
-from collections import OrderedDict
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from functools import partial
@@ -45,6 +44,8 @@ from opaline.server.methods import Methods
 from opaline.server.metrics import Metrics
 from opaline.server.render_routes import router as render_router
 from opaline.server.schemas import Health, PresetInfo, Readiness, TierInfo
+from opaline.server.statestore import LocalState, StateStore
+from opaline.server.turntable_jobs import Turntables
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
 from opaline.workers.factory import RendererFactory
@@ -145,6 +146,7 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     try:
         yield
     finally:
+        await app.state.turntables.stop()  # before the workers: stopped, not failed
         await asyncio.to_thread(app.state.pool.stop)
 
 
@@ -155,6 +157,16 @@ def renderer_for(settings: Settings) -> RendererFactory:
                            scene_bytes=settings.worker_scene_mb * mib,
                            target_bytes=settings.worker_target_mb * mib,
                            environments_dir=settings.environments_dir)
+
+
+def open_state(settings: Settings) -> StateStore:
+    """The store ``settings.state_url`` names: this process's memory when unset."""
+    if settings.state_url is None:
+        return LocalState(settings.mesh_store_bytes)
+    from opaline.server.redisstate import RedisState  # the redis package only when used
+
+    return RedisState(settings.state_url, settings.mesh_store_bytes,
+                      timeout_s=settings.state_timeout_s)
 
 
 def document(app: FastAPI, *models: type[BaseModel]) -> None:
@@ -206,8 +218,9 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")
     app.state.settings, app.state.pool = settings, pool
     app.state.cache, app.state.metrics = cache, metrics
-    app.state.meshes = MeshStore(settings)
-    app.state.turntables = OrderedDict()  # turntable_routes.Turntable by id, latest last
+    state = open_state(settings)
+    app.state.meshes = MeshStore(settings, state)
+    app.state.turntables = Turntables(state, settings)
     app.state.turntable_lanes = asyncio.Semaphore(settings.workers)
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes,
                        on_reject=partial(metrics.reject, "too_large"),

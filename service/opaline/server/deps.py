@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import asyncio
 import inspect
-from collections import OrderedDict
-from typing import Annotated, Any
+from typing import Annotated
 
 from fastapi import Depends, Request
 
 from opaline.server.service import Service
+from opaline.server.turntable_jobs import Turntables
 from opaline.settings import Settings, get_settings
 
 
@@ -41,9 +41,9 @@ async def get_service(request: Request) -> Service:
                    state.meshes)
 
 
-async def turntables(request: Request) -> OrderedDict[str, Any]:
-    """The turntables this app knows, the latest last (``turntable_routes.Turntable``)."""
-    known: OrderedDict[str, Any] = request.app.state.turntables
+async def turntables(request: Request) -> Turntables:
+    """The turntable jobs: in the state store, and those this replica runs."""
+    known: Turntables = request.app.state.turntables
     return known
 
 
@@ -55,5 +55,5 @@ async def turntable_lanes(request: Request) -> asyncio.Semaphore:
 
 SettingsDep = Annotated[Settings, Depends(app_settings)]
 ServiceDep = Annotated[Service, Depends(get_service)]
-TurntablesDep = Annotated[OrderedDict[str, Any], Depends(turntables)]
+TurntablesDep = Annotated[Turntables, Depends(turntables)]
 LanesDep = Annotated[asyncio.Semaphore, Depends(turntable_lanes)]

@@ -5,6 +5,10 @@ The HTTP process only stores and hashes bytes here: it never parses a mesh
 by the first 32 hex digits of its SHA-256, so the same file uploaded twice is
 stored once and keeps its id; a request may also name a file of the folder
 ``OPALINE_MESHES_DIR`` by its file name.
+
+With a shared state store (``OPALINE_STATE_URL``) the store holds every upload, under
+its budget, and this folder is each replica's copy of what it has used (workers read
+files): a mesh uploaded through one replica renders on any other.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import re
 import shutil
 import tempfile
 import threading
+import time
 import weakref
 from collections import OrderedDict
 from pathlib import Path
@@ -23,10 +28,12 @@ from opaline.errors import PublicError
 from opaline.model.meshes import file_digest, mesh_preset
 from opaline.model.presets import Preset
 from opaline.model.scene_fields import SceneFields
+from opaline.server.statestore import StateStore, StoreUnavailable
 from opaline.settings import Settings
 
 MESH_ID = re.compile(r"^[0-9a-f]{32}$")
 SUFFIX = ".mesh"  # the format is in the bytes; the worker sniffs it
+TOUCH_PAUSE_S = 5.0
 
 
 class UnknownMesh(PublicError, KeyError):
@@ -57,7 +64,8 @@ class MeshTooLarge(PublicError, ValueError):
 class MeshStore:
     """Files ``<id>.mesh`` in one folder, their total bytes under a budget."""
 
-    def __init__(self, settings: Settings) -> None:
+    def __init__(self, settings: Settings, shared: StateStore | None = None) -> None:
+        self.shared = shared if shared is not None and shared.shared else None
         root = settings.mesh_store_dir
         if root is None:  # a private folder, removed with the store (or at exit)
             root = Path(tempfile.mkdtemp(prefix="opaline-meshes-"))
@@ -71,6 +79,7 @@ class MeshStore:
         self._sizes: OrderedDict[str, int] = OrderedDict()
         self._folder_digests: dict[tuple[str, int, int], str] = {}
         self.evictions = 0
+        self._touch_after = 0.0
         # What an earlier run left, oldest first, so restarts keep the LRU order.
         found = sorted(self.root.glob("*" + SUFFIX), key=lambda p: p.stat().st_mtime_ns)
         for path in found:
@@ -91,6 +100,12 @@ class MeshStore:
             raise MeshTooLarge(f"mesh file of {len(data)} bytes is over this service's limit "
                                f"of {self.max_file} bytes")
         mesh_id = hashlib.sha256(data).hexdigest()[:32]
+        if self.shared is not None:  # first: an id is answered only once every replica has it
+            self.shared.put(f"mesh:{mesh_id}", data)
+        self._keep(mesh_id, data)
+        return mesh_id
+
+    def _keep(self, mesh_id: str, data: bytes) -> None:
         with self._lock:
             path = self.path_of(mesh_id)
             if mesh_id not in self._sizes:
@@ -101,13 +116,14 @@ class MeshStore:
                 self._sizes[mesh_id] = len(data)
             self._touch(mesh_id)
             self._evict(keep=mesh_id)
-        return mesh_id
 
     def discard(self, mesh_id: str) -> None:
         """Forget a mesh the worker refused, so an invalid file never takes space."""
         with self._lock:
             if self._sizes.pop(mesh_id, None) is not None:
                 self.path_of(mesh_id).unlink(missing_ok=True)
+        if self.shared is not None:
+            self.shared.delete(f"mesh:{mesh_id}")
 
     def resolve(self, name: str) -> tuple[Path, str]:
         """The file and content digest a request's ``mesh`` names; UnknownMesh if none."""
@@ -115,13 +131,27 @@ class MeshStore:
             with self._lock:
                 if name in self._sizes and self.path_of(name).is_file():
                     self._touch(name)
-                    return self.path_of(name), name
+                    return self._used(name), name
+            if self.shared is not None and (data := self.shared.get(f"mesh:{name}")):
+                self._keep(name, data)
+                return self.path_of(name), name
         elif self.folder is not None and "/" not in name and "\\" not in name \
                 and not name.startswith("."):
             path = Path(self.folder) / name
             if path.is_file():
                 return path, self._folder_digest(path)
         raise UnknownMesh(name)
+
+    def _used(self, mesh_id: str) -> Path:
+        """The local copy; the shared store hears of the use (its LRU order), if it answers:
+        a copy here renders while the store is down, and does not wait on it again for a
+        while (each try may take the store's timeout)."""
+        if self.shared is not None and time.monotonic() >= self._touch_after:
+            try:
+                self.shared.touch(f"mesh:{mesh_id}")
+            except StoreUnavailable:
+                self._touch_after = time.monotonic() + TOUCH_PAUSE_S
+        return self.path_of(mesh_id)
 
     def _folder_digest(self, path: Path) -> str:
         stat = path.stat()
