@@ -81,6 +81,22 @@ class CrashTask:
         return "crash", 0.0, 0
 
 
+@dataclass(frozen=True)
+class SlowCheckTask:
+    """Sleeps past its own time limit, as a mesh check of a slow file would."""
+
+    seconds: float = 5.0
+    time_limit_s: float = 0.5
+    label: str = "mesh-check"
+
+    def run(self, renderer, should_stop) -> bytes:
+        time.sleep(self.seconds)
+        return b"{}"
+
+    def units(self) -> tuple[str, float, int]:
+        return "mesh-check", 0.0, 0
+
+
 def no_gl():
     raise RuntimeError("no EGL device")
 

@@ -26,6 +26,13 @@ DEFAULT_PER_UNIT_S = 1.5e-6
 DEFAULT_PER_WAVELENGTH = 0.05
 DEFAULT_OVERHEAD_S = 0.02
 SAFETY = 1.5
+# A mesh check (workers.mesh_tasks) is priced by its file's size: trimesh's import on a
+# worker's first check, then about 0.14 s/MB for the slowest format (ASCII PLY), and at
+# most its own time limit, after which the worker is killed.
+CHECK_LABEL = "mesh-check"
+CHECK_TIME_LIMIT_S = 5.0
+CHECK_BASE_S = 1.0
+CHECK_S_PER_BYTE = 0.15 / (1 << 20)
 
 
 @dataclass
@@ -43,6 +50,8 @@ class CostModel:
 
     def predict(self, label: str, units: float, wavelengths: int) -> float:
         """Predicted seconds for a task (safety factor included)."""
+        if label == CHECK_LABEL:
+            return check_cost_s(units)
         with self._lock:
             found = self.labels.get(label) or self._slowest()
         raw = self.overhead_s + found.per_unit_s * units * (1.0 + found.per_wavelength * wavelengths)
@@ -74,6 +83,11 @@ class CostModel:
             return {"calibrated": self.calibrated, "overhead_s": round(self.overhead_s, 5),
                     "labels": {k: {"per_unit_s": c.per_unit_s, "per_wavelength": c.per_wavelength}
                                for k, c in self.labels.items()}}
+
+
+def check_cost_s(size_bytes: float) -> float:
+    """Predicted seconds of a mesh check of a ``size_bytes`` file, up to its time limit."""
+    return min(CHECK_TIME_LIMIT_S, SAFETY * (CHECK_BASE_S + CHECK_S_PER_BYTE * size_bytes))
 
 
 def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequence[float],

@@ -20,7 +20,7 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from opaline.workers import child
-from opaline.workers.errors import DeadlineExceeded, Unavailable
+from opaline.workers.errors import DeadlineExceeded, InvalidInput, Unavailable
 from opaline.workers.job import Job
 
 log = logging.getLogger(__name__)
@@ -163,7 +163,10 @@ class Slot:
         self._stats = stats
 
     def await_reply(self, job: Job) -> child.Reply | None:
-        limit = self.job_started + self.pool.render_timeout_s
+        # A task with its own, shorter limit (a mesh check) is refused as the input's fault.
+        own_s = getattr(job.task, "time_limit_s", None)
+        limit_s = min(self.pool.render_timeout_s, own_s or self.pool.render_timeout_s)
+        limit = self.job_started + limit_s
         while not self.conn.poll(POLL_S):
             if self.pool.stopping:
                 self.pool.fail(job, Unavailable("the service is shutting down"))
@@ -178,9 +181,11 @@ class Slot:
             if time.monotonic() > limit:
                 self.pool.counters["watchdog_kills"] += 1
                 log.error("%s: job %s (%s) ran past %g s; killing pid %d", self.name, job.key,
-                          job.label, self.pool.render_timeout_s, self.process.pid)
+                          job.label, limit_s, self.process.pid)
                 self.replace("watchdog")
-                self.pool.fail(job, DeadlineExceeded(
+                self.pool.fail(job, InvalidInput(
+                    f"{job.label} ran past this service's limit of {limit_s:g} s")
+                    if limit_s < self.pool.render_timeout_s else DeadlineExceeded(
                     f"the render ran past the {self.pool.render_timeout_s:g} s limit"))
                 return None
         try:
