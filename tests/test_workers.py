@@ -22,7 +22,7 @@ from opaline.workers.errors import (
     Unavailable,
 )
 from opaline.workers.pool import WorkerPool
-from worker_helpers import CrashTask, EchoTask, GateTask, SlowCheckTask, null_renderer
+from worker_helpers import CrashTask, EchoTask, GateTask, SlowCheckTask, SpinTask, null_renderer
 
 WAIT = 20.0
 TESTS = Path(__file__).resolve().parent
@@ -186,6 +186,31 @@ def test_a_mesh_check_costs_admission_its_predicted_time():
     model = CostModel()
     small, large = model.predict("mesh-check", 1e4, 0), model.predict("mesh-check", 64e6, 0)
     assert 1.0 < small < large == CHECK_TIME_LIMIT_S
+
+
+def test_a_stopped_worker_is_replaced_within_seconds(make_pool):
+    """Heartbeats: a worker stopped while idle (SIGSTOP) is replaced within 3 s, with no
+    job to time out; a job handed to it meanwhile is answered 503 as soon as it is found."""
+    pool = make_pool(workers=1, render_timeout_s=30.0)
+    pid = pool.status()[0]["pid"]
+    os.kill(pid, signal.SIGSTOP)
+    start = time.monotonic()
+    with pytest.raises(Unavailable, match="stopped answering"):
+        pool.submit("stuck", EchoTask()).future.result(WAIT)
+    assert time.monotonic() - start < 3.0 and not running(pid)
+    assert pool.counters["restarts_hung"] == 1 and pool.counters["watchdog_kills"] == 0
+    assert pool.submit("after", EchoTask(b"ok")).future.result(WAIT) == b"ok"
+    idle = pool.status()[0]["pid"]
+    os.kill(idle, signal.SIGSTOP)
+    wait_until(lambda: pool.status()[0]["pid"] not in (idle, None), timeout=3.0 + 1.0)
+    assert not running(idle) and pool.counters["restarts_hung"] == 2
+
+
+def test_a_busy_worker_that_uses_cpu_is_not_hung(make_pool):
+    """A render holding the GIL (no heartbeat) while it burns CPU is left to finish."""
+    pool = make_pool(workers=1, render_timeout_s=30.0)
+    assert pool.submit("spin", SpinTask(3.0)).future.result(WAIT) == b"spun"
+    assert pool.counters["restarts_hung"] == 0
 
 
 def test_a_worker_killed_while_idle_is_replaced(make_pool):

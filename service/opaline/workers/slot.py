@@ -3,9 +3,12 @@
 The thread starts the process, hands it one job at a time, and watches it:
 a job that runs past the time limit gets the process killed (the watchdog),
 a process that dies is replaced, and one that has rendered ``max_renders``
-jobs or grown past ``max_rss_bytes`` is recycled. The thread that starts a
-process stays alive as long as it (the kernel's parent-death signal is tied
-to the starting thread).
+jobs or grown past ``max_rss_bytes`` is recycled. A worker whose heartbeat
+(``child.beat``) stops while it uses no CPU either (stopped, deadlocked) is
+hung: it is killed and replaced within seconds, not at the render timeout; a
+render that holds the GIL in a long GL call still burns CPU, so it is spared.
+The thread that starts a process stays alive as long as it (the kernel's
+parent-death signal is tied to the starting thread).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ log = logging.getLogger(__name__)
 SPAWN = multiprocessing.get_context("spawn")
 POLL_S = 0.05
 RESPAWN_BACKOFF_S = (0.5, 1.0, 2.0, 5.0, 10.0)
+HUNG_AFTER_S = 2.0  # four missed heartbeats and no CPU time used meanwhile
 
 
 class Supervisor(Protocol):
@@ -57,6 +61,8 @@ class Slot:
         self.process: Any = None
         self.conn: Any = None
         self.cancel: Any = None
+        self.heartbeat: Any = None
+        self._cpu = (-1, 0.0)  # (the worker's CPU ticks, when they last changed)
         self.state = "starting"  # starting, ready, busy, failed, stopped
         self.info: dict[str, str] = {}
         self.error = ""
@@ -98,6 +104,8 @@ class Slot:
             elif self.process is not None and not self.process.is_alive():
                 log.error("%s: worker pid %d died while idle", self.name, self.process.pid)
                 self.replace("died")
+            elif self.hung():
+                self.replace("hung")
         self.shutdown()
         self.state = "stopped"
 
@@ -105,8 +113,10 @@ class Slot:
         pool = self.pool
         parent, kid = SPAWN.Pipe()
         self.cancel = SPAWN.Value("b", 0, lock=False)
+        self.heartbeat = SPAWN.Value("d", time.monotonic(), lock=False)
         process = SPAWN.Process(target=child.main, name=f"opaline-{self.name}", daemon=True,
-                                args=(kid, pool.factory, os.getpid(), pool.lp_threads, self.cancel))
+                                args=(kid, pool.factory, os.getpid(), pool.lp_threads, self.cancel,
+                                      self.heartbeat))
         process.start()
         kid.close()
         self.process, self.conn, self.renders = process, parent, 0
@@ -178,6 +188,10 @@ class Slot:
                 self.replace("died")
                 self.pool.fail(job, Unavailable("the render worker died; try again"))
                 return None
+            if self.hung():
+                self.replace("hung")
+                self.pool.fail(job, Unavailable("the render worker stopped answering; try again"))
+                return None
             if time.monotonic() > limit:
                 self.pool.counters["watchdog_kills"] += 1
                 log.error("%s: job %s (%s) ran past %g s; killing pid %d", self.name, job.key,
@@ -195,6 +209,20 @@ class Slot:
             self.replace("died")
             self.pool.fail(job, Unavailable("the render worker died; try again"))
             return None
+
+    def hung(self) -> bool:
+        """No heartbeat for ``HUNG_AFTER_S`` and no CPU time used in as long."""
+        if self.process is None or self.heartbeat is None:
+            return False
+        now = time.monotonic()
+        ticks = child.cpu_ticks(self.process.pid)
+        if ticks != self._cpu[0]:
+            self._cpu = (ticks, now)
+        if now - self.heartbeat.value <= HUNG_AFTER_S or now - self._cpu[1] <= HUNG_AFTER_S:
+            return False
+        log.error("%s: worker pid %d stopped answering (no heartbeat for %.1f s)", self.name,
+                  self.process.pid, now - self.heartbeat.value)
+        return True
 
     def replace(self, reason: str) -> None:
         """Kill this worker; the thread's loop starts a new one."""
