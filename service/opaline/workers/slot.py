@@ -3,17 +3,15 @@
 The thread starts the process, hands it one job at a time, and watches it:
 a job that runs past the time limit gets the process killed (the watchdog),
 a process that dies is replaced, and one that has rendered ``max_renders``
-jobs or grown past ``max_rss_bytes`` is recycled. A worker whose heartbeat
-(``child.beat``) stops while it uses no CPU either (stopped, deadlocked) is
-hung: it is killed and replaced within seconds, not at the render timeout; a
-render that holds the GIL in a long GL call still burns CPU, so it is spared.
-The thread that starts a process stays alive as long as it (the kernel's
-parent-death signal is tied to the starting thread).
+jobs or grown past ``max_rss_bytes`` is recycled; one with no heartbeat and no
+CPU used (stopped, deadlocked) is replaced in seconds. The thread that starts a
+process lives as long as it (parent-death signals follow the starting thread).
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import multiprocessing
 import os
 import threading
@@ -61,7 +59,7 @@ class Slot:
         self.process: Any = None
         self.conn: Any = None
         self.cancel: Any = None
-        self.heartbeat: Any = None
+        self.heartbeat: Any = None  # child.beat's clock
         self._cpu = (-1, 0.0)  # (the worker's CPU ticks, when they last changed)
         self.state = "starting"  # starting, ready, busy, failed, stopped
         self.info: dict[str, str] = {}
@@ -174,8 +172,7 @@ class Slot:
 
     def await_reply(self, job: Job) -> child.Reply | None:
         # A task with its own, shorter limit (a mesh check) is refused as the input's fault.
-        own_s = getattr(job.task, "time_limit_s", None)
-        limit_s = min(self.pool.render_timeout_s, own_s or self.pool.render_timeout_s)
+        limit_s = min(self.pool.render_timeout_s, getattr(job.task, "time_limit_s", math.inf))
         limit = self.job_started + limit_s
         while not self.conn.poll(POLL_S):
             if self.pool.stopping:
@@ -211,17 +208,15 @@ class Slot:
             return None
 
     def hung(self) -> bool:
-        """No heartbeat for ``HUNG_AFTER_S`` and no CPU time used in as long."""
+        """No heartbeat for ``HUNG_AFTER_S`` and no CPU used (a GIL-holding draw burns CPU)."""
         if self.process is None or self.heartbeat is None:
             return False
-        now = time.monotonic()
-        ticks = child.cpu_ticks(self.process.pid)
+        now, ticks = time.monotonic(), child.cpu_ticks(self.process.pid)
         if ticks != self._cpu[0]:
             self._cpu = (ticks, now)
-        if now - self.heartbeat.value <= HUNG_AFTER_S or now - self._cpu[1] <= HUNG_AFTER_S:
+        if now - max(self.heartbeat.value, self._cpu[1]) <= HUNG_AFTER_S:
             return False
-        log.error("%s: worker pid %d stopped answering (no heartbeat for %.1f s)", self.name,
-                  self.process.pid, now - self.heartbeat.value)
+        log.error("%s: pid %d hung (no heartbeat, no CPU)", self.name, self.process.pid)
         return True
 
     def replace(self, reason: str) -> None:
