@@ -12,7 +12,7 @@ from PIL import Image
 
 from opaline.model import projection
 
-BUNNY = Path(__file__).parent / "assets" / "bunny.ply"
+BUNNY = Path(__file__).parents[1] / "assets" / "bunny.ply"
 
 
 def test_weights_are_a_partition_that_follows_the_normal():
