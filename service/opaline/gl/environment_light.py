@@ -1,11 +1,8 @@
 """Environment light from its map (``glsl/lib/environment_light.glsl``): what the surface
 program compiles and is fed when a job's environment is read as a texture, not as lights.
 
-A job reads the map when its lobe is Ashikhmin-Shirley's (the rotation source's
-``ashikhmin`` MDF, thin film), unless it asks for lights (``environment_lights``).
-The multi-peak lobe spans the hemisphere and a grating's orders are sharp lobes about
-directions the sampler does not know: for those, median-cut lights (``gl/lighting.py``)
-measured closer to the brute-force reference at every tier (docs/accuracy.md).
+Which jobs read the map is ``model.environment_light.reads_map``'s decision; the others
+have median-cut lights (``gl/lighting.py``).
 The pixel's ``environment_samples`` are shared among the passes (and the 2×2 grid of
 a supersampled pass); each pass continues the pixel's sequence where the last stopped.
 """
@@ -27,13 +24,6 @@ from opaline.model.request import Job
 # standard-tier film 1.1-1.3× its key-lit time instead of 2-2.8×, but leaves a floor
 # near 0.01 that the high tier (64 samples, 0.003-0.006 exact) should not have.
 FILM_PER_SAMPLE_FROM = 16
-
-
-def reads_map(job: Job) -> bool:
-    material = job.material
-    lobe_sampled = material.iridescence == "thin-film" or (
-        material.iridescence == "rotation" and material.mdf == "ashikhmin")
-    return job.environment is not None and job.environment_lights is None and lobe_sampled
 
 
 def samples_per_pass(job: Job, samples: SamplePlan) -> int:

@@ -30,6 +30,7 @@ from opaline.gl.lighting import light_uniforms
 from opaline.gl.resolve import tonemap_defines
 from opaline.gl.resources import Resources
 from opaline.model.camera import fit_matrix, model_matrix, view_camera, view_projection
+from opaline.model.environment_light import reads_map
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.model.spectrum import wavelength_shift
@@ -132,7 +133,7 @@ class SurfacePass:
                defines: dict[str, int | bool]) -> dict[str, object]:
         """The environment's map (and its defines), or the lights: the preset's, or the
         environment's by median cut."""
-        if environment_light.reads_map(job):
+        if reads_map(job):
             assert job.environment is not None
             environment = self.backgrounds.maps.get(job.environment)
             defines.update(environment_light.defines(job, plan.samples, environment, plan.brute))

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from opaline.model.environment_light import light_equivalents
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, all_presets
 from opaline.model.request import Job, preset_fields
@@ -65,8 +66,8 @@ class ImageTask:
     def units(self) -> tuple[str, float, int, float]:
         job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
-        if job.environment:  # calibrated on the preset's lights; the cost grows with K
-            units *= max(1.0, job.environment_count / len(preset.lights))
+        if job.environment:  # calibrated on the preset's lights: the environment's in lights
+            units *= max(1.0, light_equivalents(job) / len(preset.lights))
         # Calibrated on the preset's own material: a costlier source or more orders scale
         # it up (never down: the calibration is the floor).
         own = preset_fields(preset)
