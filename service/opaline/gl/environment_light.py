@@ -17,6 +17,7 @@ import numpy as np
 
 from opaline.gl import texture_units
 from opaline.gl.passes import SamplePlan
+from opaline.gl.uniforms import Uniforms
 from opaline.model.request import Job
 
 
@@ -37,7 +38,7 @@ def defines(job: Job, samples: SamplePlan, brute: bool = False) -> dict[str, int
 
 
 def uniforms(job: Job, samples: SamplePlan, texture: moderngl.Texture,
-             sh: np.ndarray) -> dict[str, object]:
+             sh: np.ndarray) -> Uniforms:
     width, height = texture.size
     per_pixel = samples_per_pass(job, samples) * samples.passes * samples.factor ** 2
     material = job.material

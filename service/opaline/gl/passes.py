@@ -59,4 +59,5 @@ def downsample(linear: np.ndarray, factor: int) -> np.ndarray:
     if factor == 1:
         return linear
     h, w, c = linear.shape
-    return linear.reshape(h // factor, factor, w // factor, factor, c).sum(axis=(1, 3))
+    summed: np.ndarray = linear.reshape(h // factor, factor, w // factor, factor, c).sum(axis=(1, 3))
+    return summed
