@@ -38,10 +38,14 @@ from report import save  # noqa: E402
 CASES: dict[str, dict[str, Any]] = {
     "mirror": dict(mdf="ashikhmin", ex=1e6, ey=1e6, theta1=0.0, theta2=0.0),
     "glossy": dict(mdf="ashikhmin", ex=300.0, ey=300.0, theta1=0.0, theta2=0.0),
+    "broad": dict(mdf="ashikhmin", ex=20.0, ey=20.0, theta1=0.0, theta2=0.0),
     "glossy-aniso": dict(mdf="ashikhmin", ex=100.0, ey=1000.0, theta1=0.0, theta2=0.0),
     "rotation": dict(mdf="ashikhmin", ex=100.0, ey=1000.0, theta1=0.5, theta2=1.0),
     "thin-film": dict(iridescence="thin-film", ex=500.0, ey=500.0, film_ior=1.33,
                       substrate_ior=1.0, film_thickness_min=250.0, film_thickness_max=650.0),
+    "thin-film-broad": dict(iridescence="thin-film", ex=20.0, ey=20.0, film_ior=1.68,
+                            substrate_ior=1.53, film_thickness_min=350.0,
+                            film_thickness_max=550.0),
     "multipeak": dict(),  # the sphere preset's own material
 }
 TIERS = ("draft", "standard", "high")

@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_BACKDROP TONEMAP_NEUTRAL
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -57,14 +57,16 @@ in vec2 v_uv;
 
 uniform vec3 u_eye;
 uniform mat4 u_model;
-#ifndef ENVIRONMENT_MAP
+#ifdef LIGHT_COUNT
+// The preset's lights, or an environment's: as lights (median cut), or beside its map,
+// the bright features split off it (scene/bright.py).
 // xyz: position (w = 1, point light) or direction toward the light (w = 0).
 uniform vec4 u_light_position[LIGHT_COUNT];
 // Irradiance: at unit distance for point lights (falls off as 1/d²).
 uniform vec3 u_light_irradiance[LIGHT_COUNT];
-#ifdef DIFFUSE
-uniform vec3 u_ambient;
 #endif
+#if defined(DIFFUSE) && !defined(ENVIRONMENT_MAP)
+uniform vec3 u_ambient;
 #endif
 #ifdef DISPLAY
 // One sample straight into the 8-bit target (draft): encoded here as resolve.glsl
@@ -162,12 +164,14 @@ void main() {
 
     vec3 radiance = vec3(0.0);
 #ifdef ENVIRONMENT_MAP
-    // The map is the whole light: its irradiance replaces the preset's ambient term.
+    // The map is the whole light (with its bright features below): its irradiance
+    // replaces the preset's ambient term. First: it sets the per-pixel film colour.
     radiance = environment_specular(frame, v, film_nm);
 #ifdef DIFFUSE
     radiance += environment_irradiance(vec3(frame[2])) * u_kd * u_albedo / PI;
 #endif
-#else
+#endif
+#ifdef LIGHT_COUNT
     for (int i = 0; i < LIGHT_COUNT; ++i) {
         vec4 light = u_light_position[i];
         vec3 to_light = light.xyz - light.w * v_world;
@@ -176,9 +180,9 @@ void main() {
         float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
         radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v, film_nm);
     }
-#ifdef DIFFUSE
-    radiance += u_ambient * u_kd * u_albedo;
 #endif
+#if defined(DIFFUSE) && !defined(ENVIRONMENT_MAP)
+    radiance += u_ambient * u_kd * u_albedo;
 #endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
     // A free, lossless film transmits what it does not reflect: the backdrop seen

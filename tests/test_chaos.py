@@ -266,3 +266,53 @@ def test_signed_urls_keys_and_rate_limit(capsys):
         assert KEY.encode() not in body and SECRET.encode() not in body
         assert KEY not in str(headers) and SECRET not in str(headers)
     assert KEY not in log and SECRET not in log
+
+
+def test_a_stopped_worker_is_reported_and_replaced_within_seconds(capsys):
+    """SIGSTOP of the only worker (issue 24): its heartbeat stops, so /readyz answers 503
+    and a render waiting on it 503 within 3 s (not at the 30 s watchdog), and a new worker
+    takes its place."""
+    import signal
+    import threading
+
+    with start(OPALINE_CALIBRATE="false") as server:
+        ready = httpx.get(server.base + "/readyz", timeout=10)
+        assert ready.status_code == 200, ready.text
+        pid = ready.json()["workers"][0]["pid"]
+        os.kill(pid, signal.SIGSTOP)
+        stopped = time.monotonic()
+        answer: dict = {}
+
+        def render() -> None:
+            status, _, _ = get(server, "/v1/render?width=32&height=31&quality=draft")
+            answer.update(status=status, seconds=time.monotonic() - stopped)
+
+        thread = threading.Thread(target=render)
+        thread.start()
+        while httpx.get(server.base + "/readyz", timeout=10).status_code == 200:
+            assert time.monotonic() - stopped < 10, "/readyz stayed 200"
+            time.sleep(0.05)
+        not_ready = time.monotonic() - stopped
+        thread.join(30)
+        end = time.monotonic() + 60
+        while True:
+            found = httpx.get(server.base + "/readyz", timeout=10)
+            if found.status_code == 200:
+                break
+            assert time.monotonic() < end, "no worker replaced the stopped one"
+            time.sleep(0.1)
+        replaced = time.monotonic() - stopped
+        worker = found.json()["workers"][0]
+    figure(capsys, f"SIGSTOP: /readyz 503 after {not_ready:.2f} s, the render "
+                   f"{answer.get('status')} after {answer.get('seconds', 0):.2f} s, "
+                   f"a new worker ready after {replaced:.1f} s")
+    assert not_ready < 3.0 and answer["status"] == 503 and answer["seconds"] < 3.0
+    assert worker["pid"] != pid and worker["restarts"] == 1 and not running(pid)
+
+
+def running(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return False
+    return state not in ("Z", "X")

@@ -81,6 +81,44 @@ class CrashTask:
         return "crash", 0.0, 0
 
 
+@dataclass(frozen=True)
+class SlowCheckTask:
+    """Sleeps past its own time limit, as a mesh check of a slow file would."""
+
+    seconds: float = 5.0
+    time_limit_s: float = 0.5
+    label: str = "mesh-check"
+
+    def run(self, renderer, should_stop) -> bytes:
+        time.sleep(self.seconds)
+        return b"{}"
+
+    def units(self) -> tuple[str, float, int]:
+        return "mesh-check", 0.0, 0
+
+
+@dataclass(frozen=True)
+class SpinTask:
+    """Holds the GIL for ``seconds`` in one C call (as a long GL draw can), burning CPU."""
+
+    seconds: float = 3.0
+    label: str = "spin"
+
+    def run(self, renderer, should_stop) -> bytes:
+        import re
+
+        # Catastrophic backtracking: one re.match call, GIL held throughout.
+        end = time.monotonic() + self.seconds
+        n = 20
+        while time.monotonic() < end:
+            re.match(r"(a+)+$", "a" * n + "b")
+            n += 1
+        return b"spun"
+
+    def units(self) -> tuple[str, float, int]:
+        return "spin", 0.0, 0
+
+
 def no_gl():
     raise RuntimeError("no EGL device")
 

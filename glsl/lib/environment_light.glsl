@@ -54,13 +54,16 @@ float env_lod(vec3 m, float pdf_l) {
 #endif
 }
 
-// Per pixel, a shift of the whole sequence (Cranley-Patterson) by interleaved gradient
-// noise (Jimenez 2014): neighbours' shifts differ as much as they can, so the few
-// samples' error is fine-grained, high-frequency grain rather than blotches.
+// Per pixel, a shift of the whole sequence (Cranley-Patterson) from an integer hash:
+// neighbours' errors are independent grain. (Interleaved gradient noise, tried, drew
+// its diagonal lines across the high-variance lobes of the presets' films.)
 vec3 env_pixel_shift() {
-    vec2 p = floor(gl_FragCoord.xy);
-    float ign = fract(52.9829189 * fract(dot(p, vec2(0.06711056, 0.00583715))));
-    return vec3(ign, fract(ign + 0.5 * fract(p.x * 0.5 + p.y * 0.25)), fract(ign * 7.0));
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = p.x * 1973u + p.y * 9277u + 26699u;
+    h = (h ^ (h >> 16)) * 0x45d9f3bu;
+    h = (h ^ (h >> 16)) * 0x45d9f3bu;
+    h ^= h >> 16;
+    return vec3(float(h & 1023u), float((h >> 10) & 1023u), float(h >> 20)) / vec3(1024.0, 1024.0, 4096.0);
 }
 
 // Sample k of the pixel: the R2 sequence (Roberts 2018) and a third dimension for the lobe.
@@ -92,6 +95,11 @@ vec4 env_sample_half(vec3 u) {
 
 vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
     vec3 vl = vec3(transpose(frame) * real3(v));
+#ifdef FILM_PER_PIXEL
+    // At the mirror direction's v·h = n·v: over a glossy lobe v·h hardly moves, and the
+    // film is most of a sample's cost (the Sample Viewer's split sum does the same).
+    g_film_colour = film_rgb(clamp(vl.z, 0.0, 1.0), film_thickness_nm(film_nm));
+#endif
     vec3 shift = env_pixel_shift();
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {

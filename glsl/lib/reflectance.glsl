@@ -18,6 +18,20 @@ uniform float u_kd;
 uniform vec3 u_albedo;
 #endif
 
+#ifdef IRIDESCENCE_THIN_FILM
+#ifdef FILM_PER_PIXEL
+// Environment light evaluates the film once per pixel (lib/environment_light.glsl).
+vec3 g_film_colour;
+vec3 film_colour(float vh, float film_nm) {
+    return g_film_colour;
+}
+#else
+vec3 film_colour(float vh, float film_nm) {
+    return film_rgb(vh, film_thickness_nm(film_nm));
+}
+#endif
+#endif
+
 // film_nm: the thin film's thickness here (negative: the material's maximum, as KHR's
 // without a thickness texture); not read by the other sources.
 vec3 specular(realmat3 frame, vec3 l, vec3 v, float film_nm) {
@@ -35,7 +49,7 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v, float film_nm) {
     float vh = float(dot(real3(v), h));
 #ifdef IRIDESCENCE_THIN_FILM
     // The unrotated lobe, coloured by the film instead of by rotation (Fresnel off).
-    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), u_ex, u_ey) * film_rgb(vh, film_thickness_nm(film_nm));
+    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), u_ex, u_ey) * film_colour(vh, film_nm);
 #else
     vec3 d = mdf_color(hl.xy, float(hl.z));
 #endif

@@ -146,3 +146,9 @@ def test_cli_and_material_file_render_a_mesh(capsys, tmp_path):
     broken.write_bytes(broken_files()["nan-vertex-stl"])
     assert cli.main(["render", "sphere", "--mesh", str(broken), "-o", str(tmp_path / "x.png")]) == 2
     assert "NaN" in capsys.readouterr().err
+
+
+def test_a_zero_tangent_axis_is_named_in_plain_numbers():
+    """The 422 once read tangent_axis=(np.float64(0.0), ...)."""
+    with pytest.raises(MeshError, match=r"^tangent_axis=\(0\.0, 0\.0, 0\.0\) must be a finite"):
+        parse_mesh(mesh_bytes("stl"), field="concentric", axis=(0, 0, 0))

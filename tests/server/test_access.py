@@ -113,6 +113,9 @@ def test_rate_limit_answers_429_with_retry_after(backend):
     settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
                         rate_limit_per_s=0.5, rate_burst=3)
     with TestClient(create_app(settings)) as client:
+        page = [client.get(path).status_code for path in ("/", "/static/main.js",
+                                                          "/static/api.js") * 3]
+        assert page == [200] * 9  # the page and its files spend none of the budget
         answers = [client.get("/v1/presets") for _ in range(5)]
         assert [a.status_code for a in answers] == [200, 200, 200, 429, 429]
         assert answers[-1].json()["error"] == "rate_limited"

@@ -138,3 +138,40 @@ def test_exports_over_http(client):
     # parsed strictly, as POST /v1/render's body: a boolean is not a number
     lax = client.post("/v1/export/glb", json={"preset": "sphere", "light_elevation": False})
     assert lax.status_code == 422 and lax.json()["error"] == "invalid"
+
+
+def _peak_rss_mb(pid: int) -> float:
+    """The process's peak resident set (VmHWM), in MB."""
+    for line in open(f"/proc/{pid}/status"):
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) / 1024
+    return 0.0
+
+
+@pytest.mark.gl
+def test_hostile_uploads_get_422_at_once_and_the_worker_stays_small(backend, tmp_path, capsys):
+    """Issue 24's files, uploaded under the default limits: each 422 naming its limit within
+    2 s, the worker never replaced and its peak RSS barely moved (before, the 316-byte GLB
+    alone took it to 4 GB), the service ready and rendering."""
+    import time
+
+    from test_mesh_limits import HOSTILE
+
+    settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
+                        mesh_store_dir=tmp_path)
+    with TestClient(create_app(settings)) as client:
+        pid = client.get("/readyz").json()["workers"][0]["pid"]
+        before = _peak_rss_mb(pid)
+        for name, (build, words) in sorted(HOSTILE.items()):
+            start = time.monotonic()
+            answer = client.post("/v1/meshes", content=build())
+            seconds = time.monotonic() - start
+            assert answer.status_code == 422, (name, answer.text)
+            assert words in answer.json()["detail"][0] and seconds < 2.0, (name, seconds)
+            assert client.get("/readyz").json()["workers"][0]["pid"] == pid  # never killed
+        grown = _peak_rss_mb(pid) - before
+        assert client.get(f"/v1/render?preset=sphere&{SMALL}").status_code == 200
+    assert not list(tmp_path.iterdir())  # none of them kept
+    with capsys.disabled():
+        print(f"\n  hostile uploads: worker peak RSS {before:.0f} MB, +{grown:.0f} MB")
+    assert grown < 128

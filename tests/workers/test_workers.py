@@ -16,12 +16,13 @@ import pytest
 from opaline.workers.errors import (
     Cancelled,
     DeadlineExceeded,
+    InvalidInput,
     Overloaded,
     TooSlow,
     Unavailable,
 )
 from opaline.workers.pool import WorkerPool
-from worker_helpers import CrashTask, EchoTask, GateTask, null_renderer
+from worker_helpers import CrashTask, EchoTask, GateTask, SlowCheckTask, SpinTask, null_renderer
 
 WAIT = 20.0
 TESTS = Path(__file__).resolve().parents[1]  # tests/, where worker_helpers.py is
@@ -163,6 +164,53 @@ def test_a_hung_worker_is_killed_past_the_time_limit(make_pool):
     assert time.monotonic() - start < 1.0 + 1.0
     assert pool.counters["watchdog_kills"] == 1 and not running(pid)
     assert pool.submit("after", EchoTask(b"ok")).future.result(WAIT) == b"ok"
+
+
+def test_a_task_past_its_own_time_limit_is_refused_as_invalid(make_pool):
+    """A mesh check has a limit of its own, far under the render watchdog's: past it the
+    worker is killed and replaced, and the file is refused (422) naming the limit."""
+    pool = make_pool(workers=1, render_timeout_s=30.0)
+    pid = pool.status()[0]["pid"]
+    start = time.monotonic()
+    with pytest.raises(InvalidInput, match="mesh-check ran past this service's limit of 0.5 s"):
+        pool.submit("slow", SlowCheckTask()).future.result(WAIT)
+    assert time.monotonic() - start < 0.5 + 1.0
+    assert pool.counters["watchdog_kills"] == 1 and not running(pid)
+    assert pool.submit("after", EchoTask(b"ok")).future.result(WAIT) == b"ok"
+
+
+def test_a_mesh_check_costs_admission_its_predicted_time():
+    """Priced by the file's size, never free, never past its own limit."""
+    from opaline.workers.admission import CHECK_TIME_LIMIT_S, CostModel
+
+    model = CostModel()
+    small, large = model.predict("mesh-check", 1e4, 0), model.predict("mesh-check", 64e6, 0)
+    assert 1.0 < small < large == CHECK_TIME_LIMIT_S
+
+
+def test_a_stopped_worker_is_replaced_within_seconds(make_pool):
+    """Heartbeats: a worker stopped while idle (SIGSTOP) is replaced within 3 s, with no
+    job to time out; a job handed to it meanwhile is answered 503 as soon as it is found."""
+    pool = make_pool(workers=1, render_timeout_s=30.0)
+    pid = pool.status()[0]["pid"]
+    os.kill(pid, signal.SIGSTOP)
+    start = time.monotonic()
+    with pytest.raises(Unavailable, match="stopped answering"):
+        pool.submit("stuck", EchoTask()).future.result(WAIT)
+    assert time.monotonic() - start < 3.0 and not running(pid)
+    assert pool.counters["restarts_hung"] == 1 and pool.counters["watchdog_kills"] == 0
+    assert pool.submit("after", EchoTask(b"ok")).future.result(WAIT) == b"ok"
+    idle = pool.status()[0]["pid"]
+    os.kill(idle, signal.SIGSTOP)
+    wait_until(lambda: pool.status()[0]["pid"] not in (idle, None), timeout=3.0 + 1.0)
+    assert not running(idle) and pool.counters["restarts_hung"] == 2
+
+
+def test_a_busy_worker_that_uses_cpu_is_not_hung(make_pool):
+    """A render holding the GIL (no heartbeat) while it burns CPU is left to finish."""
+    pool = make_pool(workers=1, render_timeout_s=30.0)
+    assert pool.submit("spin", SpinTask(3.0)).future.result(WAIT) == b"spun"
+    assert pool.counters["restarts_hung"] == 0
 
 
 def test_a_worker_killed_while_idle_is_replaced(make_pool):

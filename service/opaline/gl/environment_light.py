@@ -1,9 +1,11 @@
 """Environment light from its map (``glsl/lib/environment_light.glsl``): what the surface
 program compiles and is fed when a job's environment is read as a texture, not as lights.
 
-A job reads the map unless it asks for lights (``environment_lights``) or draws a
-grating, whose diffraction orders are sharp lobes about directions the lobe sampler
-does not know (docs/design.md §4.6): those keep median-cut lights (``gl/lighting.py``).
+A job reads the map when its lobe is Ashikhmin-Shirley's (the rotation source's
+``ashikhmin`` MDF, thin film), unless it asks for lights (``environment_lights``).
+The multi-peak lobe spans the hemisphere and a grating's orders are sharp lobes about
+directions the sampler does not know: for those, median-cut lights (``gl/lighting.py``)
+measured closer to the brute-force reference at every tier (docs/accuracy.md).
 The pixel's ``environment_samples`` are shared among the passes (and the 2×2 grid of
 a supersampled pass); each pass continues the pixel's sequence where the last stopped.
 """
@@ -12,18 +14,27 @@ from __future__ import annotations
 
 import math
 
-import moderngl
 import numpy as np
 
 from opaline.gl import texture_units
+from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
 from opaline.model.request import Job
 
+# From this many samples a pixel, the film is evaluated at each sample's own v·h; below,
+# once at n·v. Measured against the brute-force reference (bench/environment_accuracy.py,
+# studio, 128²): once per pixel costs FLIP +0.000-0.005 at 2-4 samples, where it makes a
+# standard-tier film 1.1-1.3× its key-lit time instead of 2-2.8×, but leaves a floor
+# near 0.01 that the high tier (64 samples, 0.003-0.006 exact) should not have.
+FILM_PER_SAMPLE_FROM = 16
+
 
 def reads_map(job: Job) -> bool:
-    return (job.environment is not None and job.environment_lights is None
-            and job.material.iridescence != "grating")
+    material = job.material
+    lobe_sampled = material.iridescence == "thin-film" or (
+        material.iridescence == "rotation" and material.mdf == "ashikhmin")
+    return job.environment is not None and job.environment_lights is None and lobe_sampled
 
 
 def samples_per_pass(job: Job, samples: SamplePlan) -> int:
@@ -31,26 +42,40 @@ def samples_per_pass(job: Job, samples: SamplePlan) -> int:
     return max(1, -(-job.environment_sample_count // per_pass_pixels))
 
 
-def defines(job: Job, samples: SamplePlan, brute: bool = False) -> dict[str, int | bool]:
+def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
+            brute: bool = False) -> dict[str, int | bool]:
+    lights = len(environment.light_directions)
     return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
-            "LIGHT_COUNT": False}
+            "FILM_PER_PIXEL": (job.material.iridescence == "thin-film" and not brute
+                               and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
+            "LIGHT_COUNT": lights if lights else False}
 
 
-def uniforms(job: Job, samples: SamplePlan, texture: moderngl.Texture,
-             sh: np.ndarray) -> Uniforms:
-    width, height = texture.size
+def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap) -> Uniforms:
+    width, height = environment.texture.size
     per_pixel = samples_per_pass(job, samples) * samples.passes * samples.factor ** 2
     material = job.material
-    return {
+    rotation = math.radians(job.environment_rotation or 0.0)
+    intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
+    values: Uniforms = {
         "u_env_map": texture_units.ENVIRONMENT,
-        "u_env_rotation": math.radians(job.environment_rotation or 0.0),
-        "u_env_intensity": 1.0 if job.environment_intensity is None else job.environment_intensity,
+        "u_env_rotation": rotation,
+        "u_env_intensity": intensity,
         "u_env_size": (float(width), float(height)),
         "u_env_max_lod": float(math.floor(math.log2(max(width, height)))),
         "u_env_total": float(per_pixel),
         "u_env_pass": 0,
         "u_env_lobe_rotation": [(math.cos(a), math.sin(a))
                                 for a in (0.0, material.theta1, material.theta2)],
-        "u_env_sh": [tuple(map(float, c)) for c in sh],
+        "u_env_sh": [tuple(map(float, c)) for c in environment.irradiance],
     }
+    if len(environment.light_directions):
+        # The map turns by +rotation about +y (atan2(z, x) grows): its lights with it.
+        c, s = math.cos(rotation), math.sin(rotation)
+        turn = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        values["u_light_position"] = [(*map(float, d), 0.0)
+                                      for d in environment.light_directions @ turn]
+        values["u_light_irradiance"] = [tuple(map(float, e * intensity))
+                                        for e in environment.light_irradiance]
+    return values

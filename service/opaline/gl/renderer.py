@@ -23,6 +23,7 @@ from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import Cancelled as Cancelled  # re-exported: what workers catch
 from opaline.gl.buffers import Frame, RenderBudgets, Targets, read_bytes, read_float
 from opaline.gl.context import GLContext, create_context
+from opaline.gl.environment_maps import EnvironmentMaps
 from opaline.gl.probes import Probes
 from opaline.gl.resolve import Resolver
 from opaline.gl.resources import Resources
@@ -48,7 +49,8 @@ class Renderer:
         self.gl = gl or create_context(backend)
         self.budgets = budgets or RenderBudgets()
         self.resources = Resources(self.gl, self.budgets)
-        self.backgrounds = Backgrounds(self.ctx, self.resources.fullscreen, environments_dir)
+        self.environments = EnvironmentMaps(self.ctx, environments_dir)
+        self.backgrounds = Backgrounds(self.ctx, self.resources.fullscreen, self.environments)
         self.surface = SurfacePass(self.resources, self.backgrounds, environments_dir)
         self.resolver = Resolver(self.resources)
         self.probes = Probes(self.resources)
@@ -121,6 +123,6 @@ class Renderer:
 
     def release(self) -> None:
         self.gl.make_current()
-        self.backgrounds.release()
+        self.environments.release()
         self.resources.release()
         self.gl.release()

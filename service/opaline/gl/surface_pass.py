@@ -134,11 +134,10 @@ class SurfacePass:
         environment's by median cut."""
         if environment_light.reads_map(job):
             assert job.environment is not None
-            defines.update(environment_light.defines(job, plan.samples, plan.brute))
-            texture = self.backgrounds.texture(job.environment)
-            texture.use(location=texture_units.ENVIRONMENT)
-            return environment_light.uniforms(job, plan.samples, texture,
-                                              self.backgrounds.irradiance(job.environment))
+            environment = self.backgrounds.maps.get(job.environment)
+            defines.update(environment_light.defines(job, plan.samples, environment, plan.brute))
+            environment.texture.use(location=texture_units.ENVIRONMENT)
+            return environment_light.uniforms(job, plan.samples, environment)
         lights = light_uniforms(job, preset, self.environments_dir)
         defines["LIGHT_COUNT"] = len(lights["u_light_position"])
         return dict(lights)

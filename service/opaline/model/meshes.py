@@ -10,6 +10,7 @@ from typing import Any
 
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
+from opaline.scene.environments import MESH_ENVIRONMENT
 
 MESH_KIND = "file"
 # The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
@@ -26,8 +27,8 @@ def file_digest(path: Path) -> str:
 
 
 def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max_triangles: int) -> Preset:
-    """``base`` drawing the mesh at ``path``: its lights, background and
-    defaults and maps, the camera framed on the mesh by the renderer (the maps projected
+    """``base`` drawing the mesh at ``path``: its background, defaults and maps, lit by
+    ``MESH_ENVIRONMENT`` unless the preset names an environment, the camera framed on the mesh by the renderer (the maps projected
     in object space where the mesh has no UVs, or where the preset asks:
     ``opaline.model.projection``)."""
     # The generator's arguments (scene.meshfile.mesh_file's), of their several types.
@@ -35,8 +36,10 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
                             "tangent_field": request.tangent_field or _default_field(base),
                             "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
                             "max_triangles": max_triangles}
+    defaults = base.defaults.model_copy(
+        update={"environment": base.defaults.environment or MESH_ENVIRONMENT})
     return base.model_copy(update={"name": f"mesh-{digest[:12]}",
-                                   "geometry": Generator(**args),
+                                   "geometry": Generator(**args), "defaults": defaults,
                                    "tangents": "uv", "rotation_deg": (0.0, 0.0, 0.0)})
 
 

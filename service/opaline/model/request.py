@@ -20,6 +20,7 @@ from opaline.model.presets import Preset, get_preset
 from opaline.model.scene_fields import MESH_FIELDS
 from opaline.model.tiers import TIERS, Tier
 from opaline.resources import sources_digest
+from opaline.scene.environments import NO_ENVIRONMENT
 
 BASE_DEFAULTS = {
     "width": 256,
@@ -134,6 +135,8 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
     targets = {k: fields.pop(k, None) for k in ("max_flip", "max_delta_e")}
     if "quality" not in request.model_fields_set and any(v is not None for v in targets.values()):
         fields["quality"] = "auto"  # an error budget asks for auto unless a tier is named
+    if fields.get("environment") == NO_ENVIRONMENT:
+        fields["environment"] = None
     material = Material(**{k: fields.pop(k) for k in MATERIAL_FIELDS if k in fields})
     quality = fields.pop("quality")
     tier = pick_for(preset.name, material, fields, **targets) if quality == "auto" else TIERS[quality]

@@ -14,7 +14,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from opaline.scene.environments import BUILTIN
+from opaline.scene.environments import BUILTIN, MESH_ENVIRONMENT, NO_ENVIRONMENT
 
 TangentField = Literal["auto", "uv", "concentric", "projected"]
 Finite3 = tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
@@ -58,8 +58,10 @@ class SceneFields(BaseModel):
 
     environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
         None, description="Light the scene with an environment instead of the preset's lights: "
-                          f"{BUILT_IN}, or an .hdr/.exr file of the environments folder.",
-        examples=list(BUILTIN))
+                          f"{BUILT_IN}, or an .hdr/.exr file of the environments folder; "
+                          f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: none on "
+                          f"the presets' own geometry, '{MESH_ENVIRONMENT}' on a user's mesh.",
+        examples=[*BUILTIN, NO_ENVIRONMENT])
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Turns the environment about the up axis, degrees (default 0).")
     environment_intensity: Annotated[float, Field(ge=0.0, le=1000.0)] | None = Field(

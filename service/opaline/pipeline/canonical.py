@@ -19,6 +19,7 @@ from opaline.model.params import MATERIAL_FIELDS, RenderRequest
 from opaline.model.presets import Preset
 from opaline.model.request import Job, preset_fields, preset_material
 from opaline.model.scene_fields import MESH_FIELDS
+from opaline.scene.environments import NO_ENVIRONMENT
 
 RENDER_PATH = "/v1/render"
 # Fields of the request that the Job does not keep: the mesh (part of the scene) and
@@ -68,7 +69,9 @@ def canonical_fields(job: Job, preset: Preset, request: RenderRequest | None = N
         else:
             value, default = getattr(job, field), base.get(field)
         if _plain(value) != _plain(default):
-            fields[field] = _plain(value)
+            # No environment where the preset has one (a user's mesh) is spelled "none".
+            fields[field] = NO_ENVIRONMENT if field == "environment" and value is None \
+                else _plain(value)
     return fields
 
 

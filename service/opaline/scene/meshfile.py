@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, TypedDict
 
 import numpy as np
 
+from opaline.scene import meshlimits
 from opaline.scene import tangents as tangent_fields
 from opaline.scene.mesh import Mesh, make_mesh
 
@@ -107,6 +108,10 @@ def parse_mesh(data: bytes, suffix: str = "", field: str = "auto",
     if not data:
         raise MeshError("empty file: expected a glTF/GLB, OBJ, PLY or STL mesh")
     fmt = sniff(data, suffix)
+    try:
+        data = meshlimits.check(data, fmt, max_triangles)
+    except meshlimits.LimitError as exc:
+        raise MeshError(str(exc)) from None
     loaded = _parse(data, fmt)
     faces = np.asarray(loaded.faces, dtype=np.int64)
     positions = np.asarray(loaded.vertices, dtype=np.float64)

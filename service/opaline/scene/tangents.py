@@ -97,7 +97,7 @@ def tangent_frame(positions: np.ndarray, normals: np.ndarray, uvs: np.ndarray | 
         raise ValueError(f"tangent field {field!r} is not known: choose one of {', '.join(FIELDS)}")
     axis = np.asarray(axis, dtype=np.float64)
     if not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-9:
-        raise ValueError(f"tangent_axis={tuple(axis)} must be a finite, non-zero vector")
+        raise ValueError(f"tangent_axis={tuple(map(float, axis))} must be a finite, non-zero vector")
     axis = axis / np.linalg.norm(axis)
     centre = (positions.min(axis=0) + positions.max(axis=0)) * 0.5
     if field in ("auto", "uv") and uvs is not None:

@@ -9,7 +9,8 @@ open: they show the API's shape, never an image or a figure. Keys are compared
 in constant time and never written to an answer or a log line.
 
 ``OPALINE_RATE_LIMIT_PER_S`` limits each API key, or else each client address,
-with a token bucket of ``OPALINE_RATE_BURST``; over it: 429 with Retry-After.
+with a token bucket of ``OPALINE_RATE_BURST``; over it: 429 with Retry-After. The
+probes, the page and its static files are never limited.
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ from opaline.settings import Settings, secrets
 
 OPEN = ("/healthz", "/readyz", "/docs", "/openapi.json", "/static/", "/docs-assets/")
 SIGNABLE = ("/v1/render", "/v1/mdf")
+# Never rate-limited: the probes, and the page with its own files (one visit loads a
+# dozen, which must not spend the budget its renders need).
+UNLIMITED = ("/healthz", "/readyz", "/static/", "/docs-assets/")
 MAX_BUCKETS = 65536  # distinct keys and addresses remembered; the least recent go first
 
 
@@ -114,7 +118,7 @@ class Access:
             await problem(403, "forbidden", refusal)(scope, receive, send)
             return
         path = scope["path"]
-        if self.limiter is not None and not path.startswith(("/healthz", "/readyz")):
+        if self.limiter is not None and path != "/" and not path.startswith(UNLIMITED):
             wait = self.limiter.wait_s(identity)
             if wait > 0:
                 self.on_reject("rate_limited")

@@ -70,6 +70,10 @@ def mount_docs(app: FastAPI) -> None:
             swagger_ui_parameters={"validatorUrl": None}))
 
 
+# On every answer; also set by errors.on_crash, whose 500 leaves from outside the middleware.
+SECURITY_HEADERS = {"X-Content-Type-Options": "nosniff", "Referrer-Policy": "no-referrer"}
+
+
 class SecurityHeaders:
     """nosniff and no-referrer on every answer; the page's CSP on HTML that has none."""
 
@@ -84,8 +88,8 @@ class SecurityHeaders:
         async def send_with_headers(message: Message) -> None:
             if message["type"] == "http.response.start":
                 headers = MutableHeaders(scope=message)
-                headers.setdefault("X-Content-Type-Options", "nosniff")
-                headers.setdefault("Referrer-Policy", "no-referrer")
+                for name, value in SECURITY_HEADERS.items():
+                    headers.setdefault(name, value)
                 if headers.get("content-type", "").startswith("text/html"):
                     headers.setdefault("Content-Security-Policy", PAGE_CSP)
                     headers.setdefault("X-Frame-Options", "DENY")

@@ -27,6 +27,7 @@ from opaline.errors import PublicError
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.pipeline.limits import LimitError as LimitError
 from opaline.pipeline.prepare import UnknownEnvironment as UnknownEnvironment
+from opaline.server.docs import SECURITY_HEADERS
 from opaline.server.metrics import REJECT_REASONS
 from opaline.server.queries import MdfQuery
 
@@ -196,7 +197,10 @@ async def on_gone(request: Request, exc: ClientDisconnect) -> Response:
 async def on_crash(request: Request, exc: Exception) -> JSONResponse:
     """A bug: 500 in the public shape; the traceback goes to the log (Starlette logs it)."""
     request.app.state.metrics.reject("error")
-    return problem(500, "error", "internal error: the details are in the server log")
+    # Starlette answers this from its outermost layer, past the security headers'
+    # middleware, then re-raises, and the server drops the connection: say so.
+    return problem(500, "error", "internal error: the details are in the server log",
+                   headers={**SECURITY_HEADERS, "Connection": "close"})
 
 
 def install(app: FastAPI) -> None:

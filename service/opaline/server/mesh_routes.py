@@ -66,4 +66,9 @@ async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     except InvalidInput as exc:
         store.discard(mesh_id)
         raise InvalidMesh(str(exc)) from None
+    except BaseException:
+        # Not checked (killed, refused, waited out, the client gone): never kept, so no
+        # render can parse it unchecked.
+        store.discard(mesh_id)
+        raise
     return MeshInfo(id=mesh_id, **json.loads(summary))

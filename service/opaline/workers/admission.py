@@ -2,9 +2,13 @@
 
 The model per cost label (a preset, or the MDF plot) is
 
-    seconds = overhead + per_unit · pixels·samples · (1 + per_wavelength · wavelengths)
+    seconds = overhead + extra + per_unit · units · (1 + per_wavelength · W · growth(W))
 
-fitted from ``CalibrateTask``'s timings, measured in a worker at start-up.
+fitted from ``CalibrateTask``'s timings, measured in a worker at start-up. ``units``
+is pixels × samples, times the material's shading cost over its preset's own
+(``shading_index``: a grating's orders); ``growth`` is how much a wavelength
+costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
+``extra`` is a task's own seconds (a mesh file's parse and its triangles).
 Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
@@ -26,6 +30,18 @@ DEFAULT_PER_UNIT_S = 1.5e-6
 DEFAULT_PER_WAVELENGTH = 0.05
 DEFAULT_OVERHEAD_S = 0.02
 SAFETY = 1.5
+# A mesh check (workers.mesh_tasks) is priced by its file's size: trimesh's import on a
+# worker's first check, then about 0.14 s/MB for the slowest format (ASCII PLY), and at
+# most its own time limit, after which the worker is killed.
+CHECK_LABEL = "mesh-check"
+CHECK_TIME_LIMIT_S = 10.0  # 64 MiB, the largest upload, parses in about 8.5 s
+CHECK_BASE_S = 1.0
+CHECK_S_PER_BYTE = 0.15 / (1 << 20)
+# Per triangle and pass: 1.3M triangles drew in 0.25 s a pass (llvmpipe, 256²); a file
+# holds at least 12 bytes a triangle (uint32 indices of shared vertices).
+TRIANGLE_PASS_S = 0.25e-6
+MIN_BYTES_PER_TRIANGLE = 12
+GROWTH_W = 208.0  # growth(W) = (1 + W/208) / (1 + W_calibrated/208): ×1.5 at 128 from 16
 
 
 @dataclass
@@ -37,16 +53,20 @@ class Coefficients:
 @dataclass
 class CostModel:
     overhead_s: float = DEFAULT_OVERHEAD_S
+    calibration_wavelengths: int = 16
     labels: dict[str, Coefficients] = field(default_factory=dict)
     calibrated: bool = False
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
-    def predict(self, label: str, units: float, wavelengths: int) -> float:
+    def predict(self, label: str, units: float, wavelengths: int, extra_s: float = 0.0) -> float:
         """Predicted seconds for a task (safety factor included)."""
+        if label == CHECK_LABEL:
+            return check_cost_s(units)
         with self._lock:
             found = self.labels.get(label) or self._slowest()
-        raw = self.overhead_s + found.per_unit_s * units * (1.0 + found.per_wavelength * wavelengths)
-        return SAFETY * raw
+        growth = (1.0 + wavelengths / GROWTH_W) / (1.0 + self.calibration_wavelengths / GROWTH_W)
+        spectral = found.per_wavelength * wavelengths * growth
+        return SAFETY * (self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral))
 
     def _slowest(self) -> Coefficients:
         if not self.labels:
@@ -68,12 +88,35 @@ class CostModel:
             labels[label] = Coefficients(per_unit, max(extra, 0.0) / wavelengths)
         with self._lock:
             self.overhead_s, self.labels, self.calibrated = overhead, labels, True
+            self.calibration_wavelengths = int(wavelengths)
 
     def describe(self) -> dict[str, object]:
         with self._lock:
             return {"calibrated": self.calibrated, "overhead_s": round(self.overhead_s, 5),
                     "labels": {k: {"per_unit_s": c.per_unit_s, "per_wavelength": c.per_wavelength}
                                for k, c in self.labels.items()}}
+
+
+def shading_index(iridescence: str, orders: int) -> float:
+    """Shading cost per pixel-sample-wavelength over the paper's rotations', measured on
+    llvmpipe at 0, 16 and 128 wavelengths: a thin film 0.5-1.8× (dearest without
+    wavelengths, where it is cheap), a grating of m orders 2.3-3.3× (m = 1), 4.1-5.4× (3),
+    6.6-10× (8); the safety factor covers the spread."""
+    if iridescence == "grating":
+        return 2.0 + orders
+    return 1.25 if iridescence == "thin-film" else 1.0
+
+
+def mesh_cost_s(size_bytes: int, max_triangles: int, passes: int) -> float:
+    """Seconds a render spends on a mesh file besides shading: its parse (a worker keeps a
+    few parsed, but admission cannot know which) and its triangles drawn in every pass."""
+    triangles = min(max_triangles, size_bytes // MIN_BYTES_PER_TRIANGLE)
+    return CHECK_S_PER_BYTE * size_bytes + TRIANGLE_PASS_S * triangles * passes
+
+
+def check_cost_s(size_bytes: float) -> float:
+    """Predicted seconds of a mesh check of a ``size_bytes`` file, up to its time limit."""
+    return min(CHECK_TIME_LIMIT_S, SAFETY * (CHECK_BASE_S + CHECK_S_PER_BYTE * size_bytes))
 
 
 def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequence[float],

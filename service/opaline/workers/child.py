@@ -23,6 +23,7 @@ from typing import Any
 
 PR_SET_PDEATHSIG = 1
 PARENT_POLL_S = 0.5
+HEARTBEAT_S = 0.5  # the supervisor calls a worker hung after a few missed beats (slot.py)
 
 log = logging.getLogger(__name__)
 
@@ -47,6 +48,16 @@ def rss_bytes(pid: int | str = "self") -> int:
         return 0
 
 
+def cpu_ticks(pid: int) -> int:
+    """User and system CPU time of a process and its threads, in clock ticks (-1 if gone)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+        return int(fields[11]) + int(fields[12])
+    except (OSError, ValueError, IndexError):
+        return -1
+
+
 def die_with_parent(parent_pid: int) -> None:
     try:
         libc = ctypes.CDLL(None, use_errno=True)
@@ -63,10 +74,23 @@ def die_with_parent(parent_pid: int) -> None:
     threading.Thread(target=watch, name="opaline-parent-watch", daemon=True).start()
 
 
+def beat(heartbeat: Any) -> None:
+    """Stamp the shared clock (CLOCK_MONOTONIC is the machine's, the same in the parent)
+    from a thread of its own, so that a worker busy rendering still beats."""
+    def loop() -> None:
+        while True:
+            heartbeat.value = time.monotonic()
+            time.sleep(HEARTBEAT_S)
+
+    threading.Thread(target=loop, name="opaline-heartbeat", daemon=True).start()
+
+
 def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None,
-         cancel: Any) -> None:
+         cancel: Any, heartbeat: Any = None) -> None:
     """The worker's whole life: make the context, answer jobs until told to stop."""
     die_with_parent(parent_pid)
+    if heartbeat is not None:
+        beat(heartbeat)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     if lp_threads:
         os.environ["LP_NUM_THREADS"] = str(lp_threads)  # llvmpipe reads it at context creation

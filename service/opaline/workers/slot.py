@@ -3,14 +3,15 @@
 The thread starts the process, hands it one job at a time, and watches it:
 a job that runs past the time limit gets the process killed (the watchdog),
 a process that dies is replaced, and one that has rendered ``max_renders``
-jobs or grown past ``max_rss_bytes`` is recycled. The thread that starts a
-process stays alive as long as it (the kernel's parent-death signal is tied
-to the starting thread).
+jobs or grown past ``max_rss_bytes`` is recycled; one with no heartbeat and no
+CPU used (stopped, deadlocked) is replaced in seconds. The thread that starts a
+process lives as long as it (parent-death signals follow the starting thread).
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import multiprocessing
 import os
 import threading
@@ -20,13 +21,14 @@ from collections.abc import Callable
 from typing import Any, Protocol
 
 from opaline.workers import child
-from opaline.workers.errors import DeadlineExceeded, Unavailable
+from opaline.workers.errors import DeadlineExceeded, InvalidInput, Unavailable
 from opaline.workers.job import Job
 
 log = logging.getLogger(__name__)
 SPAWN = multiprocessing.get_context("spawn")
 POLL_S = 0.05
 RESPAWN_BACKOFF_S = (0.5, 1.0, 2.0, 5.0, 10.0)
+HUNG_AFTER_S = 2.0  # four missed heartbeats and no CPU time used meanwhile
 
 
 class Supervisor(Protocol):
@@ -57,6 +59,8 @@ class Slot:
         self.process: Any = None
         self.conn: Any = None
         self.cancel: Any = None
+        self.heartbeat: Any = None  # child.beat's clock
+        self._cpu = (-1, 0.0)  # (the worker's CPU ticks, when they last changed)
         self.state = "starting"  # starting, ready, busy, failed, stopped
         self.info: dict[str, str] = {}
         self.error = ""
@@ -98,6 +102,8 @@ class Slot:
             elif self.process is not None and not self.process.is_alive():
                 log.error("%s: worker pid %d died while idle", self.name, self.process.pid)
                 self.replace("died")
+            elif self.hung():
+                self.replace("hung")
         self.shutdown()
         self.state = "stopped"
 
@@ -105,8 +111,10 @@ class Slot:
         pool = self.pool
         parent, kid = SPAWN.Pipe()
         self.cancel = SPAWN.Value("b", 0, lock=False)
+        self.heartbeat = SPAWN.Value("d", time.monotonic(), lock=False)
         process = SPAWN.Process(target=child.main, name=f"opaline-{self.name}", daemon=True,
-                                args=(kid, pool.factory, os.getpid(), pool.lp_threads, self.cancel))
+                                args=(kid, pool.factory, os.getpid(), pool.lp_threads, self.cancel,
+                                      self.heartbeat))
         process.start()
         kid.close()
         self.process, self.conn, self.renders = process, parent, 0
@@ -163,7 +171,9 @@ class Slot:
         self._stats = stats
 
     def await_reply(self, job: Job) -> child.Reply | None:
-        limit = self.job_started + self.pool.render_timeout_s
+        # A task with its own, shorter limit (a mesh check) is refused as the input's fault.
+        limit_s = min(self.pool.render_timeout_s, getattr(job.task, "time_limit_s", math.inf))
+        limit = self.job_started + limit_s
         while not self.conn.poll(POLL_S):
             if self.pool.stopping:
                 self.pool.fail(job, Unavailable("the service is shutting down"))
@@ -175,12 +185,18 @@ class Slot:
                 self.replace("died")
                 self.pool.fail(job, Unavailable("the render worker died; try again"))
                 return None
+            if self.hung():
+                self.replace("hung")
+                self.pool.fail(job, Unavailable("the render worker stopped answering; try again"))
+                return None
             if time.monotonic() > limit:
                 self.pool.counters["watchdog_kills"] += 1
                 log.error("%s: job %s (%s) ran past %g s; killing pid %d", self.name, job.key,
-                          job.label, self.pool.render_timeout_s, self.process.pid)
+                          job.label, limit_s, self.process.pid)
                 self.replace("watchdog")
-                self.pool.fail(job, DeadlineExceeded(
+                self.pool.fail(job, InvalidInput(
+                    f"{job.label} ran past this service's limit of {limit_s:g} s")
+                    if limit_s < self.pool.render_timeout_s else DeadlineExceeded(
                     f"the render ran past the {self.pool.render_timeout_s:g} s limit"))
                 return None
         try:
@@ -190,6 +206,18 @@ class Slot:
             self.replace("died")
             self.pool.fail(job, Unavailable("the render worker died; try again"))
             return None
+
+    def hung(self) -> bool:
+        """No heartbeat for ``HUNG_AFTER_S`` and no CPU used (a GIL-holding draw burns CPU)."""
+        if self.process is None or self.heartbeat is None:
+            return False
+        now, ticks = time.monotonic(), child.cpu_ticks(self.process.pid)
+        if ticks != self._cpu[0]:
+            self._cpu = (ticks, now)
+        if now - max(self.heartbeat.value, self._cpu[1]) <= HUNG_AFTER_S:
+            return False
+        log.error("%s: pid %d hung (no heartbeat, no CPU)", self.name, self.process.pid)
+        return True
 
     def replace(self, reason: str) -> None:
         """Kill this worker; the thread's loop starts a new one."""

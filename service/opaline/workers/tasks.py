@@ -7,6 +7,7 @@ says what it costs for admission: (cost label, pixels × samples, wavelengths).
 from __future__ import annotations
 
 import json
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -14,11 +15,12 @@ from typing import Any, Protocol
 
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, all_presets
-from opaline.model.request import Job
+from opaline.model.request import Job, preset_fields
 from opaline.output.encode import encode_mdf
 from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared, prepare
 from opaline.pipeline.produce import produce
+from opaline.workers.admission import mesh_cost_s, shading_index
 
 StopCheck = Callable[[], bool]
 MDF_LABEL = "mdf-plot"
@@ -39,7 +41,8 @@ class Task(Protocol):
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes: ...
 
-    def units(self) -> tuple[str, float, int]: ...
+    # (cost label, pixels × samples, wavelengths[, seconds of its own])
+    def units(self) -> tuple[Any, ...]: ...
 
 
 @dataclass(frozen=True)
@@ -59,12 +62,30 @@ class ImageTask:
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         return produce(self.prepared, renderer, should_stop)
 
-    def units(self) -> tuple[str, float, int]:
+    def units(self) -> tuple[str, float, int, float]:
         job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
         if job.environment:  # calibrated on the preset's lights; the cost grows with K
             units *= max(1.0, job.environment_count / len(preset.lights))
-        return preset.name, units, job.wavelengths
+        # Calibrated on the preset's own material: a costlier source or more orders scale
+        # it up (never down: the calibration is the floor).
+        own = preset_fields(preset)
+        units *= max(1.0, shading_index(job.material.iridescence, job.material.grating_orders)
+                     / shading_index(own.get("iridescence") or "rotation",
+                                     own.get("grating_orders") or 3))
+        return preset.name, units, job.wavelengths, self._mesh_s()
+
+    def _mesh_s(self) -> float:
+        args = self.prepared.preset.geometry.args
+        if self.prepared.preset.geometry.kind != "file":
+            return 0.0
+        try:
+            size = os.path.getsize(args["path"])
+        except OSError:
+            return 0.0
+        passes = self.job.samples if self.job.wavelengths or self.job.samples % 4 else max(
+            1, self.job.samples // 4)
+        return mesh_cost_s(size, int(args.get("max_triangles", 2_000_000)), passes)
 
 
 @dataclass(frozen=True)

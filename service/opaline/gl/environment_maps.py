@@ -1,0 +1,66 @@
+"""Environments on the GPU: each map uploaded once with its mip chain, with what lighting
+needs besides (its irradiance coefficients, its bright features as lights), kept for a
+few environments and released with the renderer.
+
+The map uploaded is the one ``scene.bright`` leaves: a sun's texels capped at the
+threshold, their excess carried by lights. The background shows that map too; a
+capped sun is still far past white after any tone map.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+from opaline.model import irradiance
+from opaline.scene.bright import split_bright
+from opaline.scene.environments import resolve_map
+
+KEPT = 4
+
+
+@dataclass(frozen=True)
+class EnvironmentMap:
+    texture: moderngl.Texture
+    irradiance: np.ndarray  # (9, 3) of the uploaded map (model/irradiance.py)
+    light_directions: np.ndarray  # (K, 3), in the map's frame, toward the light
+    light_irradiance: np.ndarray  # (K, 3)
+
+
+class EnvironmentMaps:
+    def __init__(self, ctx: moderngl.Context, environments_dir: Path | None) -> None:
+        self.ctx = ctx
+        self.environments_dir = environments_dir
+        self._maps: OrderedDict[str, EnvironmentMap] = OrderedDict()
+
+    def get(self, name: str) -> EnvironmentMap:
+        found = self._maps.get(name)
+        if found is None:
+            found = self._upload(name)
+            self._maps[name] = found
+            while len(self._maps) > KEPT:
+                self._maps.popitem(last=False)[1].texture.release()
+        self._maps.move_to_end(name)
+        return found
+
+    def _upload(self, name: str) -> EnvironmentMap:
+        radiance, directions, lights = split_bright(resolve_map(name, self.environments_dir))
+        height, width = radiance.shape[:2]
+        # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
+        data = np.ascontiguousarray(radiance[::-1], dtype="f4")
+        texture = self.ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
+        # The one place the map's sampling is set: environment light (filtered
+        # importance sampling) and the backdrop's blur read this chain.
+        texture.build_mipmaps()
+        texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        texture.repeat_x, texture.repeat_y = True, False
+        return EnvironmentMap(texture, irradiance.coefficients(radiance), directions, lights)
+
+    def release(self) -> None:
+        for environment in self._maps.values():
+            environment.texture.release()
+        self._maps.clear()
