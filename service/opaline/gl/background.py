@@ -48,7 +48,7 @@ class Backgrounds:
 
         def draw(jitter: tuple[float, float]) -> None:
             texture.use(location=texture_units.ENVIRONMENT)
-            program["u_jitter"].value = jitter
+            program["u_jitter"] = jitter
             self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
             self.fullscreen(program)
 

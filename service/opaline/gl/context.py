@@ -42,7 +42,7 @@ class GLContext:
     renderer: str
     vendor: str
     version: str
-    _loader: object | None = field(default=None, repr=False)
+    _loader: OSMesaLoader | None = field(default=None, repr=False)
 
     @property
     def has_fp64(self) -> bool:
@@ -59,12 +59,13 @@ class GLContext:
     def make_current(self) -> None:
         """Bind this context to the calling thread. Several contexts may share a thread
         (tests, a CLI that opens two), so every entry point binds its own first."""
-        self.ctx.__enter__()
+        # moderngl's stubs leave Context.__enter__ and __exit__ unannotated.
+        self.ctx.__enter__()  # type: ignore[no-untyped-call]
 
     def release(self) -> None:
         # Unbind first: a context that is still current is only destroyed later,
         # and would stay bound under whatever context the thread uses next.
-        self.ctx.__exit__(None, None, None)
+        self.ctx.__exit__(None, None, None)  # type: ignore[no-untyped-call]
         self.ctx.release()
         if self._loader is not None:
             self._loader.release()
@@ -127,7 +128,7 @@ def pick_egl_device(extensions: list[str]) -> int:
     return 0
 
 
-def _wrap(ctx: moderngl.Context, backend: str, loader: object | None = None) -> GLContext:
+def _wrap(ctx: moderngl.Context, backend: str, loader: OSMesaLoader | None = None) -> GLContext:
     info = ctx.info
     return GLContext(
         ctx=ctx,
@@ -146,8 +147,9 @@ def create_egl() -> GLContext:
     names = {key: found for key, found in (("libegl", library("EGL")), ("libgl", library("GL")))
              if found}
     try:
+        # The stubs type each of **settings as a dict; glcontext takes plain values.
         ctx = moderngl.create_context(
-            standalone=True, backend="egl", require=GL_REQUIRE, device_index=index, **names
+            standalone=True, backend="egl", require=GL_REQUIRE, device_index=index, **names  # type: ignore[arg-type]
         )
     except Exception as exc:  # glcontext raises plain Exception subclasses
         raise ContextError(f"EGL context could not be created: {exc}") from exc
@@ -173,16 +175,18 @@ def create_osmesa() -> GLContext:
 
 def _loader_context(loader: OSMesaLoader) -> moderngl.Context:
     """What moderngl.create_context does, with a custom loader in place of a glcontext backend."""
-    from moderngl import mgl  # the C extension takes a custom loader object
+    # The C extension takes a custom loader object; the stubs declare neither it nor the
+    # private fields create_context sets, which are set here the same way.
+    from moderngl import mgl  # type: ignore[attr-defined]
 
     ctx = moderngl.Context.__new__(moderngl.Context)
     ctx.mglo, ctx.version_code = mgl.create_context(context=loader)
-    ctx._info = None
-    ctx._extensions = None
+    ctx._info = None  # type: ignore[attr-defined]
+    ctx._extensions = None  # type: ignore[attr-defined]
     ctx.extra = None
-    ctx._gc_mode = None
-    ctx._objects = deque()
-    ctx._screen = ctx.detect_framebuffer(0)
+    ctx._gc_mode = None  # type: ignore[attr-defined]
+    ctx._objects = deque()  # type: ignore[attr-defined]
+    ctx._screen = ctx.detect_framebuffer(0)  # type: ignore[attr-defined]
     ctx.fbo = ctx.detect_framebuffer()
     ctx.mglo.fbo = ctx.fbo.mglo
     return ctx

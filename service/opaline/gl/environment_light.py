@@ -16,6 +16,7 @@ import numpy as np
 from opaline.gl import texture_units
 from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
+from opaline.gl.uniforms import Uniforms
 from opaline.model.request import Job
 
 # From this many samples a pixel, the film is evaluated at each sample's own v·h; below,
@@ -41,13 +42,13 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             "LIGHT_COUNT": lights if lights else False}
 
 
-def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap) -> dict[str, object]:
+def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap) -> Uniforms:
     width, height = environment.texture.size
     per_pixel = samples_per_pass(job, samples) * samples.passes * samples.factor ** 2
     material = job.material
     rotation = math.radians(job.environment_rotation or 0.0)
     intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
-    values: dict[str, object] = {
+    values: Uniforms = {
         "u_env_map": texture_units.ENVIRONMENT,
         "u_env_rotation": rotation,
         "u_env_intensity": intensity,

@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Mapping
 
 from opaline import __version__
 from opaline.gl import material_program
 from opaline.gl.shaders import expand
+from opaline.gl.uniforms import UniformValue
 from opaline.model.params import Material
 
 UNIFORM = re.compile(r"^\s*uniform\s+(\w+)\s+(\w+)\s*(\[\s*(\w+)\s*\])?\s*;")
@@ -32,24 +34,31 @@ vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
 
 
 def _literal(kind: str, value: object) -> str:
+    """A scalar or a vector (material_program gives each vector as a tuple) as GLSL."""
     kind = GLSL_TYPES.get(kind, kind)
+    if isinstance(value, tuple):
+        parts = ", ".join(repr(float(x)) for x in value)
+        return f"{kind}({parts})"
+    if not isinstance(value, int | float):
+        raise TypeError(f"a {kind} uniform given {value!r}")
     if kind == "float":
         return repr(float(value))  # repr keeps every digit of the double
     if kind in ("int", "uint"):
-        return str(int(value))  # type: ignore[call-overload]
+        return str(int(value))
     if kind == "bool":
         return "true" if value else "false"
-    parts = ", ".join(repr(float(x)) for x in value)  # type: ignore[union-attr]
-    return f"{kind}({parts})"
+    raise TypeError(f"a {kind} uniform given the scalar {value!r}")
 
 
-def _constant(match: re.Match[str], values: dict[str, object]) -> str:
+def _constant(match: re.Match[str], values: Mapping[str, UniformValue]) -> str:
     kind, name, array = match.group(1), match.group(2), match.group(3)
     if name not in values:
         return f"// (unused by this variant) {match.group(0).strip()}"
     value = values[name]
     if array:
-        items = list(value)  # type: ignore[call-overload]
+        if not isinstance(value, list | tuple):
+            raise TypeError(f"the {kind} array {name} given {value!r}")
+        items = list(value)
         body = ", ".join(_literal(kind, v) for v in items)
         glsl = GLSL_TYPES.get(kind, kind)
         return f"const {kind} {name}[{len(items)}] = {glsl}[{len(items)}]({body});"

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from opaline.gl.uniforms import Uniforms
 from opaline.model.detail import analytic_sheet
 from opaline.model.presets import Preset
 
@@ -22,7 +23,7 @@ def defines(preset: Preset) -> dict[str, int | bool]:
     return {"WAVES": len(sheet[1])} if sheet else {}
 
 
-def uniforms(preset: Preset) -> dict[str, object]:
+def uniforms(preset: Preset) -> Uniforms:
     sheet = analytic_sheet(preset)
     if sheet is None:
         return {}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from opaline.gl.uniforms import Vector
 from opaline.model.camera import place_key_light
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -17,7 +18,7 @@ from opaline.scene.environments import environment_lights
 
 
 def light_uniforms(job: Job, preset: Preset,
-                   environments_dir: Path | None) -> dict[str, list[tuple]]:
+                   environments_dir: Path | None) -> dict[str, list[Vector]]:
     """``u_light_position`` (xyz and w: 1 point, 0 directional) and ``u_light_irradiance``."""
     if job.environment:
         direction, irradiance = environment_lights(

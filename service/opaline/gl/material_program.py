@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from opaline.gl import heightfield
+from opaline.gl.uniforms import Uniforms
 from opaline.model import grating, visible
 from opaline.model.params import Material
 from opaline.model.presets import Preset
@@ -105,9 +106,9 @@ def _cos_sin(theta: np.ndarray) -> list[tuple[float, float]]:
 
 
 def material_uniforms(material: Material, wavelengths: int = 0,
-                      shift: float = CENTRE) -> dict[str, object]:
+                      shift: float = CENTRE) -> Uniforms:
     """Every uniform the material's programs may read (a variant ignores those it lacks)."""
-    values: dict[str, object] = {
+    values: Uniforms = {
         "u_ex": material.ex,
         "u_ey": material.ey,
         "u_mu_f": material.mu_f,
@@ -127,7 +128,7 @@ def material_uniforms(material: Material, wavelengths: int = 0,
     return values
 
 
-def spectral_uniforms(material: Material, wavelengths: int, shift: float) -> dict[str, object]:
+def spectral_uniforms(material: Material, wavelengths: int, shift: float) -> Uniforms:
     """Rotations and weights of ``wavelengths`` wavelengths at ``shift`` through their bins
     (spectrum.wavelength_shift): set again before each supersample."""
     theta = rotation_at(sample_wavelengths(wavelengths, shift), material.theta1, material.theta2)
@@ -135,8 +136,8 @@ def spectral_uniforms(material: Material, wavelengths: int, shift: float) -> dic
             "u_spectral_weight": [tuple(w) for w in rgb_weights(wavelengths, shift)]}
 
 
-def _physical_uniforms(material: Material, wavelengths: int) -> dict[str, object]:
-    values: dict[str, object] = {
+def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
+    values: Uniforms = {
         "u_film_ior": material.film_ior,
         "u_substrate_ior": material.substrate_ior,
         "u_film_thickness_min": material.film_thickness_min,

@@ -59,4 +59,6 @@ def downsample(linear: np.ndarray, factor: int) -> np.ndarray:
     if factor == 1:
         return linear
     h, w, c = linear.shape
-    return linear.reshape(h // factor, factor, w // factor, factor, c).sum(axis=(1, 3))
+    # numpy's stubs type a sum over axes as Any; the sum of an array is an array.
+    summed: np.ndarray = linear.reshape(h // factor, factor, w // factor, factor, c).sum(axis=(1, 3))
+    return summed

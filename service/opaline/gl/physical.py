@@ -3,11 +3,14 @@ its thickness field as a texture, and the backdrop a transmitting film lets thro
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import moderngl
 import numpy as np
 
 
-def thickness_texture(ctx: moderngl.Context, field) -> moderngl.Texture | None:
+def thickness_texture(ctx: moderngl.Context,
+                      field: np.ndarray | None) -> moderngl.Texture | None:
     """A thickness field as a tiling, mipmapped one-channel float texture."""
     if field is None:
         return None
@@ -21,7 +24,8 @@ def thickness_texture(ctx: moderngl.Context, field) -> moderngl.Texture | None:
     return texture
 
 
-def backdrop_radiance(background, tonemap: str, exposure: float) -> tuple[float, float, float]:
+def backdrop_radiance(background: Sequence[float], tonemap: str,
+                      exposure: float) -> tuple[float, ...]:
     """The linear radiance that displays as the preset's background colour after exposure,
     tone map and sRGB encoding: what a film that transmits everything lets through."""
     from opaline.model.display import srgb_decode, tonemap_inverse

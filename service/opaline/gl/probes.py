@@ -71,7 +71,7 @@ class Probes:
                 textures.append(tex)
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.use(location=unit)
-                program[name].value = unit
+                program[name] = unit
             uniforms.apply(program, material_program.material_uniforms(material, wavelengths))
             targets = res.targets((width, height))
             targets.display_fbo.use()
@@ -101,13 +101,13 @@ class Probes:
                 textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
                 textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
                 textures[-1].use(location=unit)
-                program[name].value = unit
+                program[name] = unit
             rows, cols = texels.shape[:2]
             textures.append(res.ctx.texture((cols, rows), 4, texels.astype("f4").tobytes(),
                                             dtype="f4"))
             textures[-1].repeat_x = textures[-1].repeat_y = True
             textures[-1].use(location=2)
-            program["u_map"].value = 2
+            program["u_map"] = 2
             targets = res.targets((width, height))
             targets.display_fbo.use()
             res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)

@@ -8,8 +8,8 @@ draws (surface, resolve, probes) are handed this object; none of them owns GL st
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Hashable
+from typing import Protocol, TypeVar
 
 import moderngl
 import numpy as np
@@ -86,8 +86,21 @@ class Resources:
         self.programs.release()
 
 
-def _kept(kept: BudgetLRU[Any, Any], key: Any, make: Callable[[], Any], what: str,
-          budget: int) -> Any:
+class Kept(Protocol):
+    """What a renderer keeps under a byte budget: targets and scenes."""
+
+    @property
+    def nbytes(self) -> int: ...
+
+    def release(self) -> None: ...
+
+
+KeyT = TypeVar("KeyT", bound=Hashable)
+KeptT = TypeVar("KeptT", bound=Kept)
+
+
+def _kept(kept: BudgetLRU[KeyT, KeptT], key: KeyT, make: Callable[[], KeptT], what: str,
+          budget: int) -> KeptT:
     """``kept[key]``, made and kept if missing; released and refused if it alone is over
     the budget."""
     found = kept.get(key)

@@ -27,6 +27,8 @@ DECLARED = re.compile(r"^//!\s*defines:(.*)$")
 BRANCH = re.compile(r"^\s*#\s*(?:else|elif|endif)\b")
 
 Defines = Mapping[str, int | bool]
+# A compiled variant: its program file and its defines that are on, sorted (name, value).
+ProgramKey = tuple[str, tuple[tuple[str, int], ...]]
 
 
 class ShaderError(RuntimeError):
@@ -115,7 +117,7 @@ class ProgramCache:
                  on_release: Callable[[moderngl.Program], None] | None = None) -> None:
         self.ctx = ctx
         self.on_release = on_release
-        self._programs: BudgetLRU[tuple, moderngl.Program] = BudgetLRU(
+        self._programs: BudgetLRU[ProgramKey, moderngl.Program] = BudgetLRU(
             max_programs, max_programs * PROGRAM_BYTES, release=self._release)
 
     def __len__(self) -> int:

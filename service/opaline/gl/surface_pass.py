@@ -67,7 +67,7 @@ class Placement:
     """Where the object and the camera are, for one target's aspect."""
 
     model: np.ndarray
-    eye: tuple[float, float, float]
+    eye: tuple[float, ...]
     view_proj: np.ndarray
 
 
@@ -130,7 +130,7 @@ class SurfacePass:
         return program
 
     def _light(self, job: Job, preset: Preset, plan: DrawPlan,
-               defines: dict[str, int | bool]) -> dict[str, object]:
+               defines: dict[str, int | bool]) -> uniforms.Uniforms:
         """The environment's map (and its defines), or the lights: the preset's, or the
         environment's by median cut."""
         if reads_map(job):
@@ -144,10 +144,10 @@ class SurfacePass:
         return dict(lights)
 
     def _textures(self, job: Job, preset: Preset, scene: SceneGPU, plan: DrawPlan,
-                  defines: dict[str, int | bool]) -> dict[str, object]:
+                  defines: dict[str, int | bool]) -> uniforms.Uniforms:
         """Binds the variant's textures (once: the accumulate pass binds unit 0 only) and
         gives the uniforms that go with them."""
-        values: dict[str, object] = {}
+        values: uniforms.Uniforms = {}
         normal_map = scene.normal_map
         if normal_map is None and "NORMAL_MAP" in plan.forced:
             normal_map = self.resources.flat_normal_map()
@@ -160,6 +160,7 @@ class SurfacePass:
                 preset.background, job.tonemap, job.exposure)
         if defines.get("THICKNESS_MAP"):
             values["u_thickness_map"] = texture_units.THICKNESS_MAP
+            assert scene.thickness_map is not None  # the define follows the preset's map
             scene.thickness_map.use(location=texture_units.THICKNESS_MAP)
         return values
 
@@ -193,9 +194,9 @@ class SurfacePass:
             if front_face is not None:  # only the surface: full-screen passes are not culled
                 ctx.front_face = front_face
                 ctx.enable(moderngl.CULL_FACE)
-            program["u_jitter"].value = jitter
+            program["u_jitter"] = jitter
             if "u_env_pass" in program:
-                program["u_env_pass"].value = index
+                program["u_env_pass"] = index
             vao.render(moderngl.TRIANGLES)
             ctx.disable(moderngl.CULL_FACE)
             if accumulate is not None:
@@ -204,7 +205,7 @@ class SurfacePass:
 
     def _start_accumulation(self, targets: Targets) -> moderngl.Program:
         accumulate = self.resources.programs.get("accumulate.glsl")
-        accumulate["u_sample"].value = 0
+        accumulate["u_sample"] = 0
         targets.accum_fbo.use()
         targets.accum_fbo.clear(0.0, 0.0, 0.0, 0.0)
         return accumulate
