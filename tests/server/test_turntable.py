@@ -106,6 +106,7 @@ def test_http_turntable_with_progress(backend):
         busy = client.post("/v1/turntables", json={"preset": "sphere", "frames": 2,
                                                    "width": 32, "height": 32})
         assert busy.status_code == 429 and busy.json()["error"] == "busy", busy.text
+        assert " ".join(busy.json()["detail"]).count("retry later") == 1, busy.text
         assert int(busy.headers["retry-after"]) >= 1
         del found.running["x"]
         rendering = client.get("/v1/turntables/x/result")

@@ -75,7 +75,7 @@ async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep
     while record is None or record.value["state"] == "failed" or found.orphaned(record):
         if len(found.running) >= svc.settings.max_turntables:
             raise Busy(f"{len(found.running)} turntables are rendering, the most this service "
-                       "runs at once; retry later", retry_after_s=svc.settings.deadline_s)
+                       "runs at once", retry_after_s=svc.settings.deadline_s)
         value = new_job(key, raw.decode(), body.frames, body.animation)
         record = (await start(svc, found, value, record.version if record else 0, shared,
                               planned)
