@@ -35,7 +35,7 @@ MIB = 1024 * 1024
 
 
 def documents() -> list[dict]:
-    return [doc for path in sorted(K8S.glob("*.yaml"))
+    return [doc for path in sorted(K8S.rglob("*.yaml"))
             for doc in yaml.safe_load_all(path.read_text()) if doc]
 
 
@@ -64,7 +64,7 @@ def test_every_manifest_is_valid_for_a_current_kubernetes():
         kubernetes_validate.validate(doc, KUBERNETES, strict=True)
         kinds.add(doc["kind"])
     assert kinds == {"Deployment", "Service", "PodDisruptionBudget", "HorizontalPodAutoscaler",
-                     "PersistentVolumeClaim"}
+                     "PersistentVolumeClaim", "Job"}
 
 
 def test_the_validator_catches_a_misspelt_field():

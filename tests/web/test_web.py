@@ -8,6 +8,7 @@ import shlex
 import subprocess
 import time
 from pathlib import Path
+from urllib.parse import parse_qs, urlsplit
 
 import pytest
 
@@ -356,7 +357,7 @@ def test_page_works_with_keys_and_signing_on(browser):
 
 
 def test_dragging_shows_drafts_one_at_a_time_then_the_chosen_tier(page):
-    """While the light is dragged the preview shows draft renders (format=auto, at the
+    """While the light is dragged the preview shows draft renders (PNG, at the
     displayed size × devicePixelRatio) as they come, never more than one in flight; on
     release it shows the chosen tier. The rate is printed (bench/web_drag.py measures it)."""
     open_page(page, "?preset=sphere&quality=high")
@@ -368,6 +369,8 @@ def test_dragging_shows_drafts_one_at_a_time_then_the_chosen_tier(page):
     assert seen["frames"] >= 3 and len(drafts) >= seen["frames"]
     size = page.evaluate("Math.round(document.querySelector('#preview')"
                          ".getBoundingClientRect().width * devicePixelRatio)")
-    assert all("format=auto" in u and f"width={size}&" in u for u in drafts)
+    # Canonical URLs (test_web_canonical.py): PNG and the preset's 256 wide go unsaid.
+    widths = [parse_qs(urlsplit(u).query).get("width", ["256"]) for u in drafts]
+    assert widths == [[str(size)]] * len(drafts) and not any("format=" in u for u in drafts)
     final = page.get_attribute("#preview", "data-url")
     assert "quality=high" in final and "light_azimuth=" in final

@@ -92,12 +92,12 @@ export function setupAssets() {
   // A link (to copy or open), but a click fetches it: a link cannot carry the API key.
   $('#dl-image').addEventListener('click', (event) => {
     event.preventDefault();
-    const url = `/v1/render?${renderQuery(false)}`;
+    const url = `/v1/render?${renderQuery()}`;
     event.currentTarget.href = url;
     download('Image', () => request(url), `${state.preset}.png`);
   });
   $('#dl-glsl').addEventListener('click', () => download('GLSL',
-    () => request(`/v1/export/glsl?${renderQuery(false)}`), 'opaline.glsl'));
+    () => request(`/v1/export/glsl?${renderQuery()}`), 'opaline.glsl'));
   $('#dl-glb').addEventListener('click', () => download('glTF',
     () => postJSON('/v1/export/glb', body()), `${state.preset}.glb`));
   $('#dl-turntable').addEventListener('click', turntable);

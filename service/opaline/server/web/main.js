@@ -90,7 +90,8 @@ async function start() {
   const openapi = await load();
   if (!openapi) return;
   const schema = readSchema(openapi);
-  Object.assign(state, { specs: schema.specs, order: schema.order, groups: schema.groups });
+  Object.assign(state, { specs: schema.specs, order: schema.order, groups: schema.groups,
+    presetDefault: schema.presetDefault });
   buildControls();
   for (const preset of state.presets) {
     $('#preset').append(h('option', { value: preset.name, text: preset.name }));

@@ -3,7 +3,7 @@
 import { problemOf, request } from './api.js';
 import { $ } from './dom.js';
 import { clearErrors, routeErrors, setStatus, showError, showProblemSummary } from './errors.js';
-import { liveQuery, mdfQuery, renderQuery } from './queries.js';
+import { liveQuery, mdfQuery, previewQuery } from './queries.js';
 import { writeOutputs } from './share.js';
 import { state, valueOf } from './state.js';
 
@@ -123,7 +123,7 @@ async function update() {
   const started = performance.now();
   document.body.classList.add('loading');
   const results = await Promise.all([
-    loadImage($('#preview'), `/v1/render?${renderQuery(true)}`, inflight.signal),
+    loadImage($('#preview'), `/v1/render?${previewQuery()}`, inflight.signal),
     loadImage($('#mdf'), `/v1/mdf?${mdfQuery()}`, inflight.signal),
   ]);
   if (mine !== seq || results.some((r) => r.aborted)) return;

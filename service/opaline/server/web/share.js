@@ -12,7 +12,7 @@ const BOOLEANS = new Map([['true', true], ['1', true], ['false', false], ['0', f
 
 function pageUrl() {
   const url = new URL(location.href);
-  url.search = renderQuery(false).toString();
+  url.search = renderQuery().toString();
   url.hash = '';
   return url.toString();
 }

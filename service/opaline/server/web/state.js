@@ -15,6 +15,7 @@ export const state = {
   invalid: new Map(),    // field → local message (not a number yet)
   controls: new Map(),   // field → control
   presetError: null,     // a preset named in the link that the service does not know
+  presetDefault: null,   // the preset a request naming none draws (the schema's default)
 };
 
 export const hooks = { refreshField: () => {}, refreshInactive: () => {}, schedule: () => {} };
