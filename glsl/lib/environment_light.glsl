@@ -74,7 +74,9 @@ vec3 env_sequence(int k, vec3 shift) {
 
 // A half vector from the lobe and the density of the whole mixture there.
 vec4 env_sample_half(vec3 u) {
-#if defined(MDF_MULTIPEAK)
+#if defined(MDF_MULTIPEAK) || defined(IRIDESCENCE_GRATING)
+    // A grating's orders lie away from the mirror direction: only its brute-force
+    // reference reads the map, through the envelope as the multi-peak lobe does.
     return sample_projected_disc(u.xy);
 #elif defined(IRIDESCENCE_THIN_FILM)
     return sample_ashikhmin(u.xy, u_ex, u_ey);

@@ -133,7 +133,7 @@ class SurfacePass:
                defines: dict[str, int | bool]) -> uniforms.Uniforms:
         """The environment's map (and its defines), or the lights: the preset's, or the
         environment's by median cut."""
-        if reads_map(job):
+        if reads_map(job) or (plan.brute and job.environment is not None):
             assert job.environment is not None
             environment = self.backgrounds.maps.get(job.environment)
             defines.update(environment_light.defines(job, plan.samples, environment, plan.brute))

@@ -65,7 +65,7 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
          environment_lights=8, environment_samples=2),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
-         environment_lights=16, environment_samples=4),
+         environment_lights=16, environment_samples=6),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
     Tier("high", samples=8, wavelengths=16, aa="none",
          environment_lights=32, environment_samples=64),

@@ -37,6 +37,10 @@ LAMP_POWER = 0.25  # the faces' radiance per unit cosine over squared distance
 FACE_BASE = 0.02  # light bounced around the room: no face goes black
 # Albedo per face, in the order of _faces' index: -x, +x, -y (floor), +y, -z, +z.
 ALBEDO = np.array([0.8, 0.8, 0.55, 0.9, 0.8, 0.8])
+# The whole room's level. Glossy films show the room, not the light it casts: at the
+# earlier studio's irradiance (level 1) the gallery's objects sat at L* 14-27 and its
+# films near black; at 2.5 they sit where a product shot exposes them (docs/gallery.md).
+LEVEL = 2.5
 
 
 class Panel(NamedTuple):
@@ -109,7 +113,7 @@ def _downsample(fine: np.ndarray) -> np.ndarray:
 def studio() -> np.ndarray:
     d, _ = directions(STUDIO_SIZE[0] * SUPERSAMPLE, STUDIO_SIZE[1] * SUPERSAMPLE)
     point, face = _hits(d)
-    radiance = _panels(point, face, _faces(point, face))
+    radiance = _panels(point, face, _faces(point, face)) * LEVEL
     return _frozen(_downsample(radiance))
 
 
