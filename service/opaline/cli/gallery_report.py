@@ -20,7 +20,9 @@ PAGE_HEAD = """# Gallery
 
 Every preset, and real meshes with a set of presets, under the built-in studio and under
 their default lighting, with the mean CIELAB chroma C*ab and lightness L* over the object's
-pixels (display sRGB, D65; the object's pixels are those a transparent render covers).
+pixels (display sRGB, D65; the object's pixels are those a transparent render covers),
+and the mean C*ab of the backdrop around it (a film that lets the backdrop through
+carries some of its chroma).
 
 """
 
@@ -69,13 +71,13 @@ def label(row: dict[str, Any]) -> str:
 
 def table(rows: list[dict[str, Any]], folder: str) -> str:
     """The Markdown table: one line per picture, linked."""
-    lines = ["| preset | mesh | lighting | mean C*ab | mean L* | picture |",
-             "|---|---|---|---:|---:|---|"]
+    lines = ["| preset | mesh | lighting | mean C*ab | mean L* | backdrop C*ab | picture |",
+             "|---|---|---|---:|---:|---:|---|"]
     for row in rows:
-        chroma = "–" if row["chroma"] is None else f"{row['chroma']:.1f}"
-        lightness = "–" if row["lightness"] is None else f"{row['lightness']:.1f}"
+        figures = " | ".join("–" if row[key] is None else f"{row[key]:.1f}"
+                             for key in ("chroma", "lightness", "backdrop_chroma"))
         lines.append(f"| `{row['preset']}` | {row['mesh'] or '(its own)'} | {row['lighting']} | "
-                     f"{chroma} | {lightness} | [{row['image']}]({folder}/{row['image']}) |")
+                     f"{figures} | [{row['image']}]({folder}/{row['image']}) |")
     return "\n".join(lines)
 
 

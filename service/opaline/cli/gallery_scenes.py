@@ -68,19 +68,20 @@ def mesh_shots(meshes: Sequence[Path], presets: Sequence[str]) -> list[Shot]:
 
 def object_colour(image: bytes, mask: bytes) -> dict[str, float | int | None]:
     """Mean C*ab and L* of ``image``'s pixels where ``mask`` (the same view rendered
-    transparent) is covered; None where nothing is."""
+    transparent) is covered, and the mean C*ab of the rest: a film that lets the backdrop
+    through carries the backdrop's chroma too. None where there are no such pixels."""
     import numpy as np
     from PIL import Image
 
     with Image.open(io.BytesIO(image)) as shown, Image.open(io.BytesIO(mask)) as cover:
-        rgb = np.asarray(shown.convert("RGB"), dtype=np.float64) / 255.0
+        lab = srgb_to_lab(np.asarray(shown.convert("RGB"), dtype=np.float64) / 255.0)
         covered = np.asarray(cover.convert("RGBA"))[..., 3] >= COVERED
-    lab = srgb_to_lab(rgb[covered])
-    pixels = int(covered.sum())
-    if pixels == 0:
-        return {"chroma": None, "lightness": None, "pixels": 0}
-    return {"chroma": round(float(chroma(lab).mean()), 2),
-            "lightness": round(float(lab[:, 0].mean()), 2), "pixels": pixels}
+
+    def mean(values: Any) -> float | None:
+        return round(float(values.mean()), 2) if values.size else None
+
+    return {"chroma": mean(chroma(lab[covered])), "lightness": mean(lab[covered][:, 0]),
+            "pixels": int(covered.sum()), "backdrop_chroma": mean(chroma(lab[~covered]))}
 
 
 def lighting_name(renderer: LocalRenderer, request: RenderRequest) -> str:
