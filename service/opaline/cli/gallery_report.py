@@ -19,9 +19,9 @@ END = "<!-- gallery-table: end -->"
 PAGE_HEAD = """# Gallery
 
 Every preset, and real meshes with a set of presets, under the built-in studio and under
-their default lighting, with the mean CIELAB chroma C*ab and lightness L* over the object's
-pixels (display sRGB, D65; the object's pixels are those a transparent render covers),
-and the mean C*ab of the backdrop around it (a film that lets the backdrop through
+their default lighting, with the mean CIELAB chroma C\\*ab and lightness L\\* over the
+object's pixels (display sRGB, D65; the object's pixels are those a transparent render
+covers), and the mean C\\*ab of the backdrop around it (a film that lets the backdrop through
 carries some of its chroma).
 
 """
@@ -71,7 +71,7 @@ def label(row: dict[str, Any]) -> str:
 
 def table(rows: list[dict[str, Any]], folder: str) -> str:
     """The Markdown table: one line per picture, linked."""
-    lines = ["| preset | mesh | lighting | mean C*ab | mean L* | backdrop C*ab | picture |",
+    lines = ["| preset | mesh | lighting | mean C\\*ab | mean L\\* | backdrop C\\*ab | picture |",
              "|---|---|---|---:|---:|---:|---|"]
     for row in rows:
         figures = " | ".join("–" if row[key] is None else f"{row[key]:.1f}"
@@ -82,7 +82,7 @@ def table(rows: list[dict[str, Any]], folder: str) -> str:
 
 
 def sheets_section(sheets: list[str], folder: str) -> str:
-    return "\n".join(f"![{name}]({folder}/{name})" for name in sheets)
+    return "\n\n".join(f"![{name}]({folder}/{name})" for name in sheets)
 
 
 def write_page(page: Path, rows: list[dict[str, Any]], sheets: list[str], folder: str) -> None:
