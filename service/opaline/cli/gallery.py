@@ -1,14 +1,19 @@
-"""``opaline gallery``: the README's pictures, one image per preset and the MDF figures."""
+"""``opaline gallery``: the README's pictures: every preset under its own lights and under
+the studio, real meshes with a set of presets (``gallery_scenes``), each with its mean
+chroma; contact sheets and the table (``gallery_report``); the paper's MDF figures."""
 
 from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, get_args
 
+from opaline.cli import gallery_report as report
+from opaline.cli import gallery_scenes as scenes
 from opaline.cli.args import add_common
-from opaline.model.params import Material, Quality, RenderRequest
+from opaline.model.params import Material, Quality
 from opaline.output.files import write_atomic
 
 # The paper's MDF figures. Figs. 2, 6, 7 are single-channel (no rotation);
@@ -58,42 +63,69 @@ def build_gallery(
     mdf_size: int = 256,
     backend: str | None = None,
     quality: Quality = "standard",
-) -> dict[str, list[str]]:
+    presets: Sequence[str] | None = None,
+    meshes: Sequence[Path] | None = None,
+    mesh_presets: Sequence[str] | None = None,
+) -> dict[str, list[Any]]:
+    """Every picture, gallery.json, and the table of ``out``'s page (docs/gallery.md for
+    docs/gallery). None: every preset; the checkout's meshes; the mesh presets it has."""
     from opaline.local.pipeline import LocalRenderer
     from opaline.model.presets import all_presets
 
+    chosen = list(all_presets()) if presets is None else list(presets)
+    if meshes is None:
+        meshes = [mesh for mesh in scenes.DEFAULT_MESHES if mesh.is_file()]
+    if mesh_presets is None:
+        mesh_presets = [name for name in scenes.MESH_PRESETS if name in all_presets()]
+    shots = scenes.preset_shots(chosen) + scenes.mesh_shots(meshes, mesh_presets)
     out.mkdir(parents=True, exist_ok=True)
-    written: dict[str, list[str]] = {"presets": [], "mdf": []}
+    written: dict[str, list[Any]] = {"presets": [f"preset-{name}.png" for name in chosen],
+                                     "mdf": [], "measured": [], "sheets": []}
     with LocalRenderer(backend) as renderer:
-        for name in all_presets():
-            request = RenderRequest(preset=name, width=size, height=size, quality=quality)
-            path = out / f"preset-{name}.png"
-            write_atomic(path, renderer.render_bytes(request))
-            written["presets"].append(path.name)
+        for shot in shots:
+            written["measured"].append(scenes.render_shot(renderer, shot, out, size, quality))
         for name, fields in MDF_FIGURES.items():
             path = out / f"mdf-{name}.png"
             write_atomic(path, renderer.mdf_bytes(Material(**fields), mdf_size))
             written["mdf"].append(path.name)
+    written["sheets"] = report.write_sheets(out, written["measured"])
     write_atomic(out / "gallery.json", json.dumps(written, indent=2).encode())
+    report.write_page(out.parent / f"{out.name}.md", written["measured"], written["sheets"],
+                      out.name)
     return written
 
 
+def names(value: str) -> list[str]:
+    return [name.strip() for name in value.split(",") if name.strip()]
+
+
 def cmd_gallery(args: argparse.Namespace) -> None:
-    written = build_gallery(Path(args.out), args.size, args.mdf_size, args.backend, args.quality)
-    print(
-        f"wrote {len(written['presets'])} preset images and {len(written['mdf'])} MDF plots to {args.out}"
-    )
+    meshes = None if args.mesh is None else [Path(mesh) for mesh in args.mesh]
+    written = build_gallery(Path(args.out), args.size, args.mdf_size, args.backend, args.quality,
+                            args.presets, meshes, args.mesh_presets)
+    print(f"wrote {len(written['measured'])} measured images, {len(written['mdf'])} MDF plots "
+          f"and {len(written['sheets'])} contact sheets to {args.out}")
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser(
-        "gallery", help="render every preset and the paper's MDF figures (README pictures)"
+        "gallery", help="render every preset (own lights, studio), real meshes with a set of "
+        "presets, and the paper's MDF figures, with each picture's chroma (README pictures)"
     )
     parser.add_argument(
-        "--out", default="docs/gallery", help="output folder (default docs/gallery)"
+        "--out", default="docs/gallery",
+        help="output folder (default docs/gallery); the table goes to OUT.md beside it"
     )
     parser.add_argument("--size", type=int, default=256, help="preset image size (default 256)")
     parser.add_argument("--mdf-size", type=int, default=256, help="MDF plot size (default 256)")
     parser.add_argument("--quality", default="standard", choices=get_args(Quality))
+    parser.add_argument("--presets", type=names, default=None, metavar="LIST",
+                        help="comma-separated presets to render (default: every preset)")
+    parser.add_argument("--mesh", action="append", default=None, metavar="PATH",
+                        help="a mesh file to render the mesh presets on; repeat for more "
+                        "(default: the checkout's tests/assets bunny.ply, spot.obj, teapot.obj)")
+    parser.add_argument("--mesh-presets", type=names, default=None, metavar="LIST",
+                        help="comma-separated presets shown on each mesh, '' for none "
+                        f"(default: {','.join(scenes.MESH_PRESETS)})")
     add_common(parser)
     parser.set_defaults(func=cmd_gallery)
