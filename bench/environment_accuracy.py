@@ -46,6 +46,8 @@ CASES: dict[str, dict[str, Any]] = {
     "thin-film-broad": dict(iridescence="thin-film", ex=20.0, ey=20.0, film_ior=1.68,
                             substrate_ior=1.53, film_thickness_min=350.0,
                             film_thickness_max=550.0),
+    "bubble": dict(iridescence="thin-film", ex=4.0, ey=4.0, film_ior=1.33, substrate_ior=1.0,
+                   film_thickness_min=0.0, film_thickness_max=1000.0),
     "multipeak": dict(),  # the sphere preset's own material
 }
 TIERS = ("draft", "standard", "high")

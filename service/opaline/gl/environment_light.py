@@ -24,7 +24,7 @@ from opaline.model.request import Job
 # studio, 128²): once per pixel costs FLIP +0.000-0.005 at 2-4 samples, where it makes a
 # standard-tier film 1.1-1.3× its key-lit time instead of 2-2.8×, but leaves a floor
 # near 0.01 that the high tier (64 samples, 0.003-0.006 exact) should not have.
-FILM_PER_SAMPLE_FROM = 16
+FILM_PER_SAMPLE_FROM = 48
 
 
 def samples_per_pass(job: Job, samples: SamplePlan) -> int:
