@@ -4,8 +4,8 @@
 // samplers, the irradiance and the estimator can be held against their float64
 // twins case by case. u_mode: 0 sample_ashikhmin(a.xy), 1 sample_projected_disc(a.xy),
 // 2 env_sample_half(a.xyz): (h, pdf); 3 environment_irradiance(a); 4 one pass of
-// environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1). Mode 0
-// needs the A-S variant (u_ex, u_ey).
+// environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1); 5 sample
+// k = a.x of env_sequence shifted by b. Mode 0 needs the A-S variant (u_ex, u_ey).
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
@@ -36,6 +36,8 @@ void main() {
         frag_color = vec4(environment_irradiance(a), 1.0);
     } else if (u_mode == 4) {
         frag_color = vec4(environment_specular(shading_frame(a, b), c, -1.0), 1.0);
+    } else if (u_mode == 5) {
+        frag_color = vec4(env_sequence(int(a.x), b), 1.0);
     }
 }
 #endif

@@ -120,6 +120,22 @@ def test_thin_film_and_multipeak_sample_their_own_lobe(renderer, ex, ey):
     check_samples(gl, h, pdf, u, np.zeros(len(u)))
 
 
+def test_sequence_agrees_at_every_sample_index(renderer):
+    """env_sequence(k) is the twin's R2 point at any k a pixel reaches (4096 samples,
+    a tier's most, up to the probe's 2^18): within 2e-7 plus k·2.4e-10, the 32-bit
+    fixed-point rounding of the R2 constants."""
+    k = np.concatenate([np.arange(64), np.geomspace(64, 2 ** 18, 200).astype(int), [4095]])
+    shift = as_f32(np.random.default_rng(8).random((len(k), 3)))
+    cases = (np.stack([k, k, k], -1).astype(np.float64), shift)
+    gl = renderer.probes.lobe(material(1.0, 1.0), "sequence", cases)[0][:, :3]
+    expected = ls.sequence(k, shift)
+    diff = np.abs(gl - expected)
+    diff = np.minimum(diff, 1.0 - diff)  # the unit interval wraps
+    bound = 2e-7 + k[:, None] * 2.4e-10
+    worst = int((diff / bound).max(1).argmax())
+    assert np.all(diff <= bound), f"k = {k[worst]}: gl {gl[worst]}, twin {expected[worst]}"
+
+
 @pytest.mark.parametrize("name", ["studio", "sky"])
 @pytest.mark.parametrize("rotation,intensity", [(0.0, 1.0), (2.0, 0.25), (-TWO_PI, 1000.0)])
 def test_irradiance_agrees(renderer, name, rotation, intensity):

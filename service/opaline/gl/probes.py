@@ -17,7 +17,8 @@ from opaline.gl.resources import Resources
 from opaline.model.params import Material
 
 # glsl/lobe_probe.glsl's modes: what each case evaluates.
-LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4}
+LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4,
+              "sequence": 5}
 
 
 class Probes:
