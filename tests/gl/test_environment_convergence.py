@@ -107,7 +107,8 @@ def test_brute_force_estimate_converges_to_the_quadrature(renderer, radiance, na
     assert np.isfinite(passes).all() and (passes >= 0).all()
     estimate = passes.mean(0)
     error = passes.std(0, ddof=1) / math.sqrt(PASSES)
-    expected = np.array([quadrature(mat, radiance, n, t, v, rotation) for n, t, v in zip(N, T, V)])
+    expected = np.array([quadrature(mat, radiance, n, t, v, rotation)
+                         for n, t, v in zip(N, T, V, strict=True)])
     bound = 4.0 * error + 1e-3 * expected.max(1, keepdims=True)
     off = np.abs(estimate - expected) / bound
     case, channel = np.unravel_index(int(off.argmax()), off.shape)
