@@ -4,7 +4,7 @@ user's file (sanitised on reading: scene/environments.py) render every colour so
 and MDF at draft, standard and high as linear float (format=npy) with 0 non-finite
 pixels; black lights nothing, one texel lights within the estimator's bound.
 
-The maps are stability_cases.ENVIRONMENT_MAPS, written as .exr/.hdr files into a
+The maps are environment_cases.ENVIRONMENT_MAPS, written as .exr/.hdr files into a
 temporary environments folder that the session's renderer reads.
 """
 
@@ -15,10 +15,11 @@ import math
 import numpy as np
 import pytest
 
+from environment_cases import BRIGHT_TEXEL, ENVIRONMENT_MAPS, write_environment
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
-from stability_cases import BRIGHT_TEXEL, ENVIRONMENT_MAPS, EXTREMES, write_environment
+from stability_cases import EXTREMES
 
 pytestmark = pytest.mark.gl
 

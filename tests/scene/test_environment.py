@@ -223,7 +223,7 @@ def test_backdrop_leaves_the_object_alone(local):
 def test_a_users_broken_texels_are_sanitised_and_logged(tmp_path, caplog):
     """NaN, ±Inf and negatives read as 0, radiance above MAX_RADIANCE as the maximum,
     the rest as written; the worker's log says how many were changed."""
-    from stability_cases import ENVIRONMENT_MAPS, write_environment
+    from environment_cases import ENVIRONMENT_MAPS, write_environment
 
     pytest.importorskip("OpenEXR")
     written = ENVIRONMENT_MAPS["nan-inf"][1]()
@@ -240,7 +240,7 @@ def test_a_users_broken_texels_are_sanitised_and_logged(tmp_path, caplog):
 
 
 def test_a_clean_file_reads_unchanged_and_silently(tmp_path, caplog):
-    from stability_cases import ENVIRONMENT_MAPS, write_environment
+    from environment_cases import ENVIRONMENT_MAPS, write_environment
 
     pytest.importorskip("OpenEXR")
     with caplog.at_level("WARNING", logger="opaline.scene.environments"):
