@@ -67,9 +67,14 @@ vec3 env_pixel_shift() {
 }
 
 // Sample k of the pixel: the R2 sequence (Roberts 2018) and a third dimension for the lobe.
+// (k + ½)·α mod 1 in 32-bit fixed point (α = 0.7548776662, 0.5698402910, 0.6180339887
+// times 2^32): in float, (k + ½)·α keeps 24 - log2(k·α) bits of its fraction, so at
+// k = 4096 a point was off by 1e-4 and the brute-force reference's late samples fell
+// on a coarse grid (tests/gl/test_environment_twins.py).
 vec3 env_sequence(int k, vec3 shift) {
-    float n = float(k) + 0.5;
-    return fract(shift + n * vec3(0.7548776662, 0.5698402910, 0.6180339887));
+    uvec3 alpha = uvec3(3242174889u, 2447445414u, 2654435769u);
+    uvec3 fraction = uint(k) * alpha + (alpha >> 1u);
+    return fract(shift + vec3(fraction) * (1.0 / 4294967296.0));
 }
 
 // A half vector from the lobe and the density of the whole mixture there.

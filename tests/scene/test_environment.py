@@ -32,6 +32,13 @@ def test_median_cut_keeps_the_total_and_finds_the_bright_part(name):
     assert solid_total == pytest.approx(4 * np.pi, rel=1e-3)
 
 
+def test_a_black_map_is_one_light_of_nothing():
+    """Not zero lights: the surface program cannot be compiled with LIGHT_COUNT 0."""
+    toward, irradiance = median_cut(np.zeros((16, 32, 3)), 8)
+    assert toward.shape == irradiance.shape == (1, 3)
+    assert np.all(irradiance == 0.0) and np.linalg.norm(toward) == pytest.approx(1.0)
+
+
 def test_rotation_turns_the_lights_about_up():
     base, e0 = environments.environment_lights("sky", 4)
     turned, e1 = environments.environment_lights("sky", 4, rotation_deg=90.0, intensity=2.0)
@@ -211,3 +218,32 @@ def test_backdrop_leaves_the_object_alone(local):
     covered = plain[..., 3] == 1.0
     assert covered.sum() > 300
     np.testing.assert_array_equal(shown[covered, :3], plain[covered, :3])
+
+
+def test_a_users_broken_texels_are_sanitised_and_logged(tmp_path, caplog):
+    """NaN, ±Inf and negatives read as 0, radiance above MAX_RADIANCE as the maximum,
+    the rest as written; the worker's log says how many were changed."""
+    from environment_cases import ENVIRONMENT_MAPS, write_environment
+
+    pytest.importorskip("OpenEXR")
+    written = ENVIRONMENT_MAPS["nan-inf"][1]()
+    with caplog.at_level("WARNING", logger="opaline.scene.environments"):
+        radiance = environments.read_file(tmp_path / write_environment(tmp_path, "nan-inf"))
+    broken = ~np.isfinite(written) | (written < 0)
+    assert np.all(radiance[broken] == 0.0)
+    huge = ~broken & (written > environments.MAX_RADIANCE)
+    assert huge.any() and np.all(radiance[huge] == environments.MAX_RADIANCE)
+    rest = ~broken & ~huge
+    assert np.array_equal(radiance[rest], written[rest])
+    assert f"{int(broken.sum())} non-finite or negative values set to 0" in caplog.text
+    assert f"{int(huge.sum())} above 1e+10 clamped" in caplog.text
+
+
+def test_a_clean_file_reads_unchanged_and_silently(tmp_path, caplog):
+    from environment_cases import ENVIRONMENT_MAPS, write_environment
+
+    pytest.importorskip("OpenEXR")
+    with caplog.at_level("WARNING", logger="opaline.scene.environments"):
+        radiance = environments.read_file(tmp_path / write_environment(tmp_path, "range-1e5"))
+    assert np.array_equal(radiance, ENVIRONMENT_MAPS["range-1e5"][1]())
+    assert caplog.text == ""

@@ -11,10 +11,14 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from opaline.gl import material_program, uniforms
+from opaline.gl import material_program, texture_units, uniforms
 from opaline.gl.buffers import read_float
 from opaline.gl.resources import Resources
 from opaline.model.params import Material
+
+# glsl/lobe_probe.glsl's modes: what each case evaluates.
+LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4,
+              "sequence": 5}
 
 
 class Probes:
@@ -117,3 +121,57 @@ class Probes:
             for tex in textures:
                 tex.release()
         return image[::-1].reshape(-1, 4)[:count]
+
+    def lobe(self, material: Material, mode: str, cases: tuple[np.ndarray, ...],
+             environment: tuple[moderngl.Texture, np.ndarray] | None = None,
+             rotation: float = 0.0, intensity: float = 1.0, samples: int = 1,
+             passes: int = 1, brute: bool = True) -> np.ndarray:
+        """glsl/lobe_probe.glsl for each case (up to three (count, 3) inputs, see its
+        modes in ``LOBE_MODES``): (passes, count, 4), pass k continuing the pixel's
+        sequence as the surface's passes do. ``environment``: the map's texture and
+        irradiance coefficients (gl/background.py's), ``samples`` a pass's lobe samples,
+        ``brute`` level 0 always (else the filtered read, for ``samples · passes`` in all)."""
+        res = self.resources
+        res.gl.make_current()
+        count = len(cases[0])
+        width = min(count, 256)
+        height = -(-count // width)
+        defines = {**material_program.material_defines(material), "ENV_SAMPLES": samples,
+                   "ENV_BRUTE": brute}
+        program = res.programs.get("lobe_probe.glsl", defines)
+        values = material_program.material_uniforms(material)
+        values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,
+                       "u_env_intensity": intensity, "u_env_total": float(samples * passes),
+                       "u_env_lobe_rotation": [(np.cos(a), np.sin(a)) for a in
+                                               (0.0, material.theta1, material.theta2)]})
+        if environment is not None:
+            texture, sh = environment
+            texture.use(location=texture_units.ENVIRONMENT)
+            values.update({"u_env_map": texture_units.ENVIRONMENT,
+                           "u_env_size": (float(texture.width), float(texture.height)),
+                           "u_env_max_lod": float(np.floor(np.log2(max(texture.size)))),
+                           "u_env_sh": [tuple(map(float, c)) for c in sh]})
+        textures = []
+        try:
+            for unit, data in enumerate(cases):
+                grid = np.zeros((height * width, 4), dtype="f4")
+                grid[:count, :3] = data
+                textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
+                textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
+                textures[-1].use(location=unit)
+                values["u_case_" + "abc"[unit]] = unit
+            uniforms.apply(program, values)
+            targets = res.targets((width, height))
+            results = []
+            for index in range(passes):
+                if "u_env_pass" in program:
+                    program["u_env_pass"].value = index
+                targets.display_fbo.use()
+                res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+                res.fullscreen(program)
+                image = read_float(targets.display_fbo, (width, height))
+                results.append(image[::-1].reshape(-1, 4)[:count])
+        finally:
+            for tex in textures:
+                tex.release()
+        return np.stack(results)

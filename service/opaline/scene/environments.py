@@ -13,11 +13,15 @@ nothing to ship and are the same on every machine:
 Files (Radiance ``.hdr`` through OpenCV's reader, OpenEXR ``.exr`` through
 the OpenEXR package) are read from
 the environments folder of the settings, in the worker processes; both
-libraries are imported only when a file is asked for.
+libraries are imported only when a file is asked for. A file's NaN, infinite and
+negative texels become 0 and its radiance is clamped to ``MAX_RADIANCE`` (logged):
+a photographed or rendered map with a few broken pixels still lights a scene, and
+nothing it holds can reach a pixel as NaN or Inf.
 """
 
 from __future__ import annotations
 
+import logging
 from collections import OrderedDict
 from pathlib import Path
 
@@ -37,6 +41,13 @@ MESH_ENVIRONMENT = "sky"
 SIZE = (128, 256)  # rows, columns: 1.4° per texel, enough for the sun's disc
 SUFFIXES = (".hdr", ".exr")
 CACHED = 8
+# The most radiance a file's texel keeps. Far above any real scene in relative units (a
+# sun is ~1e5 times its sky); below it every range at its end (environment_intensity
+# 1000, ks 100, the three-lobe mixture's weight 3, exposure 1000: 3e8 per unit radiance)
+# keeps fp32 finite through the ACES tone map, whose x² overflows above 1.8e19.
+MAX_RADIANCE = 1e10
+
+log = logging.getLogger(__name__)
 
 
 class EnvironmentMapError(ValueError):
@@ -85,10 +96,22 @@ def read_file(path: Path) -> np.ndarray:
                                   f"{exc.name}, a dependency of opaline: reinstall it") from None
     except (OSError, ValueError, KeyError, RuntimeError) as exc:
         raise EnvironmentMapError(f"environment {path.name}: cannot read: {exc}") from None
-    if image.ndim != 3 or image.shape[2] < 3 or not np.all(np.isfinite(image[..., :3])):
+    if image.ndim != 3 or image.shape[2] < 3:
         raise EnvironmentMapError(f"environment {path.name}: expected finite RGB, got "
                                 f"shape {image.shape}")
-    return np.maximum(image[..., :3], 0.0)
+    return sanitised(path.name, image[..., :3])
+
+
+def sanitised(name: str, radiance: np.ndarray) -> np.ndarray:
+    """NaN, ±Inf and negative texels as 0 (a broken pixel is no light: an Inf taken as the
+    maximum would put a sun where none is), the rest clamped to ``MAX_RADIANCE``."""
+    broken = ~np.isfinite(radiance) | (radiance < 0.0)
+    bright = ~broken & (radiance > MAX_RADIANCE)
+    if broken.any() or bright.any():
+        log.warning("environment %s: %d non-finite or negative values set to 0, %d above "
+                    "%g clamped", name, int(broken.sum()), int(bright.sum()), MAX_RADIANCE)
+    clean: np.ndarray = np.where(broken, 0.0, np.minimum(radiance, MAX_RADIANCE))
+    return clean.astype(np.float32)
 
 
 def check_name(name: str, folder: Path | None) -> Path | None:

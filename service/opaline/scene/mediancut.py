@@ -39,7 +39,8 @@ def median_cut(radiance: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray
 
     The region with the most energy is split next (not every region each round), so K
     need not be a power of two and bright features get lights first. Fewer than
-    ``count`` come back only if the map has fewer texels with energy."""
+    ``count`` come back only if the map has fewer texels with energy; a black map gives
+    one light of irradiance 0."""
     height, width = radiance.shape[:2]
     d, solid = directions(height, width)
     power = radiance.astype(np.float64) * solid[..., None]  # (H, W, 3): ∫L dω per texel
@@ -93,4 +94,8 @@ def median_cut(radiance: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray
             continue
         lights_d.append(centroid / norm)
         lights_e.append(p.sum(0))
+    if not lights_d:
+        # A black map: one light carrying nothing, for GLSL has no empty arrays (a
+        # LIGHT_COUNT of 0 does not compile).
+        lights_d, lights_e = [np.array([0.0, 1.0, 0.0])], [np.zeros(3)]
     return np.array(lights_d).reshape(-1, 3), np.array(lights_e).reshape(-1, 3)

@@ -1,0 +1,43 @@
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS ENV_SAMPLES ENV_BRUTE
+// Test harness for environment light: each pixel runs one case read from float
+// textures through lib/lobe_sampling.glsl and lib/environment_light.glsl, so the
+// samplers, the irradiance and the estimator can be held against their float64
+// twins case by case. u_mode: 0 sample_ashikhmin(a.xy), 1 sample_projected_disc(a.xy),
+// 2 env_sample_half(a.xyz): (h, pdf); 3 environment_irradiance(a); 4 one pass of
+// environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1); 5 sample
+// k = a.x of env_sequence shifted by b. Mode 0 needs the A-S variant (u_ex, u_ey).
+#include "fullscreen.glsl"
+
+#ifdef FRAGMENT_SHADER
+#include "lib/environment_light.glsl"
+
+uniform sampler2D u_case_a;
+uniform sampler2D u_case_b;
+uniform sampler2D u_case_c;
+uniform int u_mode;
+out vec4 frag_color;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec3 a = texelFetch(u_case_a, px, 0).xyz;
+    vec3 b = texelFetch(u_case_b, px, 0).xyz;
+    vec3 c = texelFetch(u_case_c, px, 0).xyz;
+    frag_color = vec4(0.0);
+#ifdef MDF_ASHIKHMIN
+    if (u_mode == 0) {
+        frag_color = sample_ashikhmin(a.xy, u_ex, u_ey);
+    }
+#endif
+    if (u_mode == 1) {
+        frag_color = sample_projected_disc(a.xy);
+    } else if (u_mode == 2) {
+        frag_color = env_sample_half(a);
+    } else if (u_mode == 3) {
+        frag_color = vec4(environment_irradiance(a), 1.0);
+    } else if (u_mode == 4) {
+        frag_color = vec4(environment_specular(shading_frame(a, b), c, -1.0), 1.0);
+    } else if (u_mode == 5) {
+        frag_color = vec4(env_sequence(int(a.x), b), 1.0);
+    }
+}
+#endif
