@@ -165,7 +165,7 @@ class Probes:
             results = []
             for index in range(passes):
                 if "u_env_pass" in program:
-                    program["u_env_pass"].value = index
+                    program["u_env_pass"] = index
                 targets.display_fbo.use()
                 res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
                 res.fullscreen(program)
