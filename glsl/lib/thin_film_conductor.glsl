@@ -29,14 +29,15 @@ vec2 c_sqrt(vec2 z) {
     return vec2(0.5 * abs(z.y) / im, z.y < 0.0 ? -im : im);
 }
 
-// The film's top interface (s, p), as film_interfaces; false where light cannot enter.
+// The film's top interface (s, p), as film_interfaces; false where light cannot enter,
+// and exactly at grazing, where all is reflected (over a lossless ñ = 1 Airy is 0/0).
 bool film_top(float cos1, out float cos2, out vec2 r12) {
     float nf = u_film_ior;
     float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
     cos2 = sqrt(max(cos2_sq, 0.0));
     r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
                film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
-    return cos2_sq > 0.0;
+    return cos2_sq > 0.0 && cos1 > 0.0;
 }
 
 // The lower interface over ñ = nk: complex r23 for s (.xy) and p (.zw), with
@@ -44,7 +45,9 @@ bool film_top(float cos1, out float cos2, out vec2 r12) {
 vec4 film_conductor_r23(float cos1, float cos2, vec2 nk) {
     float nf = u_film_ior;
     vec2 n_sq = c_mul(nk, nk);
-    vec2 n_cos3 = c_sqrt(n_sq + vec2(cos1 * cos1 - 1.0, 0.0));
+    // (ñ² - 1) + cos²θ1, in that order, as the dielectric's cos²θ3: near grazing
+    // cos²θ1 - 1 rounds to -1 in float, which would turn ñ = 1 into a mirror.
+    vec2 n_cos3 = c_sqrt(vec2(n_sq.x - 1.0 + cos1 * cos1, n_sq.y));
     vec2 top_s = vec2(nf * cos2, 0.0);
     vec2 top_p = n_sq * cos2;
     vec2 bottom_p = nf * n_cos3;

@@ -67,8 +67,10 @@ def _conductor_interfaces(
     cos1: FloatArray, cos2_sq: npt.NDArray[Any], n_film: float, n_sub: npt.NDArray[np.complex128]
 ) -> tuple[FloatArray, Amplitudes, Amplitudes, npt.NDArray[np.bool_]]:
     """``interfaces`` over ñ = n + ik: ñ·cos θ3 = √(ñ² - sin²θ1) on the principal branch,
-    whose imaginary part is ≥ 0 (the wave decays into the metal for k > 0)."""
-    tir = cos2_sq <= 0.0
+    whose imaginary part is ≥ 0 (the wave decays into the metal for k > 0). Exactly
+    grazing light is reflected whole, as the dielectric's test for total reflection
+    has it (a = -1 there; over a lossless ñ = 1, b = 1 too and Airy's sum is 0/0)."""
+    tir = (cos2_sq <= 0.0) | (cos1 <= 0.0)
     cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
     n_cos3 = np.sqrt(n_sub * n_sub - 1.0 + cos1 * cos1 + 0j)
     n_sq = n_sub * n_sub
