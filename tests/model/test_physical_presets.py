@@ -14,7 +14,8 @@ from opaline.model.request import resolve
 from opaline.model.tiers import TIERS
 from opaline.scene import thickness
 
-PHYSICAL = ["oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film"]
+PHYSICAL = ["oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film",
+            "anodised-titanium", "tempered-steel", "tempered-copper"]
 
 
 @pytest.mark.parametrize("kind", ["swirl", "drain", "platelets"])
