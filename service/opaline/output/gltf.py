@@ -28,6 +28,7 @@ from opaline.output.gltf_iridescence import (
     IRIDESCENCE,
     add_thickness_texture,
     is_thin_film,
+    roughness_from_exponent,
     thickness_png,
     thin_film_extensions,
     thin_film_fields,
@@ -38,10 +39,10 @@ EXTRAS_KEY = "opaline"
 
 
 def _roughness(material: Material) -> float:
-    """A rough stand-in for viewers: the MDF's width as GGX-like roughness (no exact map)."""
+    """A rough stand-in for viewers: the MDF's width as GGX-like roughness (no exact map;
+    an A-S lobe's by its wider exponent's equivalent GGX width)."""
     if material.mdf == "ashikhmin" or material.iridescence != "rotation":  # A-S lobe
-        exponent = max(min(material.ex, material.ey), 1e-3)
-        return float(np.clip(np.sqrt(2.0 / (exponent + 2.0)), 0.02, 1.0))
+        return roughness_from_exponent(min(material.ex, material.ey))
     return float(np.clip(0.15 * (material.alpha + material.beta) / 2.0, 0.05, 1.0))
 
 

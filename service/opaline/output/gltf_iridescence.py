@@ -80,6 +80,24 @@ def _number(block: dict[str, Any], key: str, default: float) -> float:
     return float(value)
 
 
+# glTF's roughness r is perceptual: the GGX width is α = r² (glTF 2.0 spec, appendix B),
+# and the A-S (Blinn-Phong) exponent of the same width is n = 2/α² - 2 (Walter et al.
+# 2007, §5.2), so n = 2/r⁴ - 2; roughness 0.1 is n ≈ 20 000, not the 198 of r read as α.
+EXPONENT_MAX = 1e6  # Material's range
+
+
+def exponent_from_roughness(roughness: float) -> float:
+    """The A-S exponent of a glTF roughness (clamped to [0.02, 1] as importers do)."""
+    alpha = float(np.clip(roughness, 0.02, 1.0)) ** 2
+    return float(min(2.0 / alpha**2 - 2.0, EXPONENT_MAX))
+
+
+def roughness_from_exponent(exponent: float) -> float:
+    """glTF roughness of an A-S exponent: the inverse of ``exponent_from_roughness``."""
+    alpha = np.sqrt(2.0 / (max(exponent, 0.0) + 2.0))
+    return float(np.clip(np.sqrt(alpha), 0.02, 1.0))
+
+
 def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     """Request fields of a material carrying KHR_materials_iridescence (ValueError if the
     film is off or outside Opaline's ranges). The base's roughness becomes the A-S lobe's
@@ -92,11 +110,10 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     if _number(film, "iridescenceFactor", 0.0) <= 0.0:
         raise ValueError(f"{IRIDESCENCE} has iridescenceFactor 0: the film is off")
     pbr = material.pbrMetallicRoughness or gl.PbrMetallicRoughness()
-    roughness = float(np.clip(pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0,
-                              0.02, 1.0))
     metallic = pbr.metallicFactor if pbr.metallicFactor is not None else 1.0
     colour = list(pbr.baseColorFactor or [1.0, 1.0, 1.0, 1.0])[:3]
-    exponent = float(min(2.0 / roughness**2 - 2.0, 1e6))
+    exponent = exponent_from_roughness(
+        pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0)
     fields = {
         "iridescence": "thin-film",
         "film_ior": _number(film, "iridescenceIor", KHR_IOR),
