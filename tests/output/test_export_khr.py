@@ -153,3 +153,24 @@ def test_exported_roughness_inverts_the_import(exponent):
     document.materials[0].extras = {}
     back = import_glb(b"".join(document.save_to_bytes()))
     assert back["ex"] == pytest.approx(exponent, rel=1e-4, abs=1e-6)
+
+
+def test_film_on_a_metal_exports_a_metallic_base_of_its_f0():
+    """A conductor under the film (issue 23) is a metallic base whose colour is the bare
+    metal's F0 (gold: warm), with no KHR_materials_ior; the KHR-only file imports as the
+    artist metal of that F0, and the extras give back the tabulated metal exactly."""
+    request = RenderRequest(preset="sphere", **FILM, substrate="conductor", metal="gold")
+    data = export_material(request, "glb")
+    material = _load(data).materials[0]
+    pbr = material.pbrMetallicRoughness
+    assert pbr.metallicFactor == 1.0 and "KHR_materials_ior" not in material.extensions
+    red, green, blue = pbr.baseColorFactor[:3]
+    assert red > 0.95 and 0.65 < green < 0.8 and 0.3 < blue < 0.42  # published: 1, 0.78, 0.34
+    fields = import_glb(data)
+    assert fields["substrate"] == "conductor" and fields["metal"] == "gold"
+    document = _load(data)
+    document.materials[0].extras = {}
+    fields = import_glb(b"".join(document.save_to_bytes()))
+    assert fields["substrate"] == "conductor" and fields["metal"] == "artist"
+    assert fields["metal_f0"] == pytest.approx([red, green, blue]) and fields["kd"] == 0.0
+    RenderRequest.model_validate(fields)
