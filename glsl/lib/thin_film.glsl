@@ -3,8 +3,10 @@
 // air, at cos θ1 = v·h. Real indices make the Fresnel amplitudes a = r12 and
 // b = r23 real and signed (the sign is the interface's 0 or π phase shift):
 //   R(φ) = (a² + b² + 2ab·cos φ) / (1 + a²b² + 2ab·cos φ),  φ = 4π·n·d·cos θ2/λ,
-// averaged over s and p; total internal reflection gives 1. Float64 twin:
-// opaline/model/thinfilm.py.
+// averaged over s and p; total internal reflection gives 1. Under a conductor
+// (SUBSTRATE_CONDUCTOR) the index below is complex, n + ik, and so is b: the same
+// sum is exact with b·cos φ replaced by Re(b·e^{iφ}) (b's phase adds to the film's).
+// Float64 twin: opaline/model/thinfilm.py.
 #ifndef THIN_FILM_GLSL
 #define THIN_FILM_GLSL
 #include "lib/common.glsl"
@@ -43,7 +45,9 @@ bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
     return cos2_sq > 0.0 && cos3_sq > 0.0;
 }
 
-#if WAVELENGTHS > 0
+#ifdef SUBSTRATE_CONDUCTOR
+#include "lib/thin_film_conductor.glsl"
+#elif WAVELENGTHS > 0
 uniform float u_wavelength_nm[WAVELENGTHS];
 
 float film_airy(float a, float b, float c) {

@@ -35,6 +35,11 @@ VARIANTS = {
     "thin-film": (Material(mdf="ashikhmin", iridescence="thin-film", film_thickness_min=250.0,
                            film_thickness_max=250.0), 16),
     "grating-fast": (Material(mdf="ashikhmin", iridescence="grating", ex=2000.0, ey=2000.0), 0),
+    # A film on a metal: complex arrays of n + ik (vec2) per wavelength or per channel.
+    "conductor-spectral": (Material(iridescence="thin-film", substrate="conductor",
+                                    metal="titanium", film_ior=2.4), 16),
+    "conductor-fast": (Material(iridescence="thin-film", substrate="conductor", metal="gold",
+                                film_ior=1.5, film_thickness_max=120.0), 0),
 }
 
 

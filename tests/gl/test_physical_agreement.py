@@ -196,3 +196,45 @@ def test_shader_orders_land_where_the_grating_equation_puts_them(renderer, wavel
     t = np.tile([1.0, 0.0, 0.0], (3, 1))
     gl = renderer.probe(material, n, t, l, v, wavelengths)
     assert list(gl.argmax(axis=1)) == [2, 1, 0], gl
+
+
+METALS = ("gold", "silver", "copper", "aluminium", "titanium", "iron", "bismuth", "artist")
+
+
+def conductor_material(rng: np.random.Generator) -> Material:
+    """A film on a random metal (issue 23): a tabulated one or an artist's F0 and tint."""
+    return film_material(
+        rng, substrate="conductor", metal=str(rng.choice(METALS)),
+        metal_f0=tuple(float(x) for x in rng.uniform(0.0, 1.0, 3)),
+        metal_edge_tint=tuple(float(x) for x in rng.uniform(0.0, 1.0, 3)))
+
+
+def test_100_random_conductor_sets_agree(renderer):
+    rng = np.random.default_rng(23)
+    worst = 0.0
+    for _ in range(100):
+        material = conductor_material(rng)
+        wavelengths = int(rng.choice(WAVELENGTH_CHOICES))
+        worst = max(worst, check(renderer, material, cases_for(rng, material), wavelengths)[0])
+    print(f"conductor: 100 random sets, worst error {worst:.3g} of the bound")
+
+
+# The artist's F0 (1 is taken as 0.99, metals.F0_MAX) with tints 0 and 1 gives n ≈ 400
+# (k = 0) and n ≈ 0.005, k ≈ 1; tint 0.5 about n ≈ 200, k ≈ 100: the metals' extremes,
+# far beyond the tables' k ≤ 8.5.
+CONDUCTOR_ENDS = {
+    "film_ior": (1.0, 3.0),
+    "film_thickness_max": (0.0, 2000.0),
+    "metal_f0": ((0.0, 0.0, 0.0), (1.0, 0.5, 1.0)),
+    "metal_edge_tint": ((0.0, 0.5, 1.0), (1.0, 1.0, 0.0)),
+    "ex": (0.0, 1e6),
+}
+
+
+@pytest.mark.parametrize("wavelengths", [0, 16])
+def test_conductor_extremes_grid_agrees(renderer, wavelengths):
+    rng = np.random.default_rng(8)
+    for fields in grid(CONDUCTOR_ENDS):
+        material = Material(iridescence="thin-film", substrate="conductor", metal="artist",
+                            ey=1e3, **fields)
+        check(renderer, material, cases_for(rng, material), wavelengths)

@@ -14,7 +14,8 @@ from opaline.model.request import resolve
 from opaline.model.tiers import TIERS
 from opaline.scene import thickness
 
-PHYSICAL = ["oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film"]
+PHYSICAL = ["oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film",
+            "anodised-titanium", "tempered-steel", "tempered-copper"]
 
 
 @pytest.mark.parametrize("kind", ["swirl", "drain", "platelets"])
@@ -85,15 +86,17 @@ def test_thickness_field_maps_to_min_max(renderer):
 @pytest.mark.gl
 def test_transparent_film_shows_the_background_exactly(renderer):
     """A soap film of thickness 0 reflects nothing and transmits everything: with no
-    specular, the bubble's pixels display as the background colour itself."""
+    specular, the bubble's pixels display as the background colour itself (the preset's
+    colour, not its environment behind it)."""
     preset = get_preset("soap-bubble")
     request = RenderRequest(preset="soap-bubble", width=32, height=32, quality="draft",
                             film_thickness_min=0.0, film_thickness_max=0.0, ks=0.0,
+                            environment_background=False,
                             format="png16")  # float display values
     display = renderer.render(resolve(request, preset), preset=preset).display
     assert np.abs(display[..., :3] - np.array(preset.background)).max() < 2e-3
     # And a real film tints it: not the background everywhere.
     request = RenderRequest(preset="soap-bubble", width=32, height=32, quality="draft", ks=0.0,
-                            format="png16")
+                            environment_background=False, format="png16")
     tinted = renderer.render(resolve(request, preset), preset=preset).display
     assert np.abs(tinted[..., :3] - np.array(preset.background)).max() > 0.02

@@ -82,13 +82,15 @@ def test_every_file_loads():
         assert load_preset_file(path).name == path.stem
 
 
-PHYSICAL = {"oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film"}
+PHYSICAL = {"oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film",
+            "anodised-titanium", "tempered-steel", "tempered-copper"}  # films on metals: issue 23
 
 
 def test_preset_names_are_the_eight_of_design_and_the_physical_ones():
-    """The presets are exactly the eight of docs/design.md §6 and the five physical ones (issue 14)."""
+    """The presets are exactly the eight of docs/design.md §6, the five physical ones (issue
+    14) and the three films on metals (issue 23)."""
     assert set(all_presets()) == set(PAPER) | PHYSICAL
-    assert len(all_presets()) == 13
+    assert len(all_presets()) == 16
 
 
 @pytest.mark.parametrize("name", sorted(PAPER))

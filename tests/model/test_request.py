@@ -146,7 +146,8 @@ CHANGED_MATERIAL = {
     "theta1": 0.11, "theta2": 0.21, "kd": 0.3, "ks": 0.6, "albedo": (0.7, 0.7, 0.73), "f0": 0.9,
     "iridescence": "thin-film", "film_ior": 1.4, "film_thickness_min": 120.0,
     "film_thickness_max": 420.0, "substrate_ior": 1.33, "grating_pitch": 0.74,
-    "grating_orders": 2, "grating_depth": 120.0,
+    "grating_orders": 2, "grating_depth": 120.0, "substrate": "conductor", "metal": "artist",
+    "metal_f0": (0.9, 0.6, 0.3), "metal_edge_tint": (1.0, 0.9, 0.8),
 }
 
 

@@ -5,6 +5,7 @@ export → import keeps every field."""
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 import pygltflib
@@ -75,7 +76,7 @@ def test_khr_only_glb_imports_as_thin_film():
         "iridescence": "thin-film", "film_ior": 1.8, "film_thickness_min": 50.0,
         "film_thickness_max": 900.0, "substrate_ior": 1.2}
     assert fields["albedo"] == [0.1, 0.2, 0.3] and fields["kd"] == 1.0
-    assert fields["ex"] == fields["ey"] == pytest.approx(2 / 0.3**2 - 2)
+    assert fields["ex"] == fields["ey"] == pytest.approx(2 / 0.3**4 - 2)  # α = r²
     # Absent keys take the extension's defaults, the base ior glTF's 1.5.
     fields = import_glb(_khr_only({"iridescenceFactor": 1.0}, None))
     assert {k: fields[k] for k in FIELDS[1:]} == {
@@ -110,3 +111,66 @@ def test_round_trip_keeps_thin_film_fields(preset):
     document.materials[0].extras = {}
     fields = import_glb(b"".join(document.save_to_bytes()))
     assert {k: fields[k] for k in FIELDS} == FILM
+
+
+def ggx_half_width(alpha: float) -> float:
+    """θ_h where GGX's D = α²/(π((α² - 1)cos²θ + 1)²) falls to half its peak:
+    (1 + tan²θ/α²)² = 2."""
+    return math.atan(alpha * math.sqrt(math.sqrt(2.0) - 1.0))
+
+
+def phong_half_width(exponent: float) -> float:
+    """θ_h where the isotropic A-S lobe, cos^n θ_h, falls to half its peak."""
+    return math.acos(0.5 ** (1.0 / exponent))
+
+
+@pytest.mark.parametrize("roughness", [0.02, 0.05, 0.1, 0.2, 0.3, 0.5])
+def test_imported_roughness_has_the_ggx_lobe_width(roughness):
+    """KHR roughness r is GGX's α = r²: the imported A-S lobe is as wide as that GGX lobe
+    at half maximum, within the shapes' difference (A-S with n = 2/α² - 2 has Beckmann's
+    width, 1.29× GGX's at half maximum; 1.34× at r = 0.5, and wider toward r = 1, 1.5× at
+    0.7 and 2.1× at 0.9, where the -2 that keeps n ≥ 0 counts). Read as α (the old
+    mapping) it was about 1/r times too wide: 13× at r = 0.1."""
+    fields = import_glb(_khr_only({"iridescenceFactor": 1.0}, 1.5, roughness=roughness))
+    exponent = 2.0 / roughness**4 - 2.0
+    ratio = phong_half_width(min(exponent, 1e6)) / ggx_half_width(roughness**2)
+    assert fields["ex"] == fields["ey"] == pytest.approx(min(exponent, 1e6))
+    if exponent <= 1e6:  # beyond: the exponent's range, narrower than fp32 resolves anyway
+        assert 1.25 < ratio < 1.35
+    if roughness == 0.1:
+        assert fields["ex"] == pytest.approx(19998.0)  # issue 23's example: not 198
+
+
+@pytest.mark.parametrize("exponent", [0.0, 2.0, 20.0, 198.0, 2e4, 1e6])
+def test_exported_roughness_inverts_the_import(exponent):
+    """Export writes the roughness whose import gives the exponent back (while the
+    roughness is inside glTF's usual clamp, 0.02 … 1)."""
+    request = RenderRequest(preset="sphere", **FILM, mdf="ashikhmin", ex=exponent, ey=exponent)
+    document = _load(export_material(request, "glb"))
+    roughness = document.materials[0].pbrMetallicRoughness.roughnessFactor
+    alpha = math.sqrt(2.0 / (exponent + 2.0))
+    assert roughness == pytest.approx(math.sqrt(alpha), rel=1e-6)  # not α itself
+    document.materials[0].extras = {}
+    back = import_glb(b"".join(document.save_to_bytes()))
+    assert back["ex"] == pytest.approx(exponent, rel=1e-4, abs=1e-6)
+
+
+def test_film_on_a_metal_exports_a_metallic_base_of_its_f0():
+    """A conductor under the film (issue 23) is a metallic base whose colour is the bare
+    metal's F0 (gold: warm), with no KHR_materials_ior; the KHR-only file imports as the
+    artist metal of that F0, and the extras give back the tabulated metal exactly."""
+    request = RenderRequest(preset="sphere", **FILM, substrate="conductor", metal="gold")
+    data = export_material(request, "glb")
+    material = _load(data).materials[0]
+    pbr = material.pbrMetallicRoughness
+    assert pbr.metallicFactor == 1.0 and "KHR_materials_ior" not in material.extensions
+    red, green, blue = pbr.baseColorFactor[:3]
+    assert red > 0.95 and 0.65 < green < 0.8 and 0.3 < blue < 0.42  # published: 1, 0.78, 0.34
+    fields = import_glb(data)
+    assert fields["substrate"] == "conductor" and fields["metal"] == "gold"
+    document = _load(data)
+    document.materials[0].extras = {}
+    fields = import_glb(b"".join(document.save_to_bytes()))
+    assert fields["substrate"] == "conductor" and fields["metal"] == "artist"
+    assert fields["metal_f0"] == pytest.approx([red, green, blue]) and fields["kd"] == 0.0
+    RenderRequest.model_validate(fields)

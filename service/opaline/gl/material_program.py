@@ -28,7 +28,7 @@ import numpy as np
 
 from opaline.gl import heightfield
 from opaline.gl.uniforms import Uniforms
-from opaline.model import grating, visible
+from opaline.model import grating, metals, visible
 from opaline.model.params import Material
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -76,7 +76,13 @@ def material_defines(material: Material, wavelengths: int = 0, aa: str = "none")
     }
     if is_physical(material):
         defines.update(_physical_defines(material))  # applied last: the physical source wins
+    if is_conductor(material):
+        defines["SUBSTRATE_CONDUCTOR"] = True
     return defines
+
+
+def is_conductor(material: Material) -> bool:
+    return material.iridescence == "thin-film" and material.substrate == "conductor"
 
 
 def uses_thickness_map(material: Material, preset: Preset) -> bool:
@@ -84,7 +90,8 @@ def uses_thickness_map(material: Material, preset: Preset) -> bool:
 
 
 def uses_transmission(material: Material, preset: Preset) -> bool:
-    return material.iridescence == "thin-film" and preset.transmission
+    # A metal under the film lets nothing through.
+    return material.iridescence == "thin-film" and preset.transmission and not is_conductor(material)
 
 
 def surface_defines(job: Job, preset: Preset) -> Defines:
@@ -145,6 +152,9 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
         "u_grating_pitch_nm": 1000.0 * material.grating_pitch,
         "u_grating_depth_nm": material.grating_depth,
     }
+    if is_conductor(material):
+        nk = np.atleast_1d(metals.substrate_for(material, wavelengths))
+        values["u_substrate_nk"] = [(float(x.real), float(x.imag)) for x in nk]
     if wavelengths > 0:
         values["u_wavelength_nm"] = [float(x) for x in sample_wavelengths(wavelengths)]
     else:

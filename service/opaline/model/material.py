@@ -28,6 +28,9 @@ STRICT = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
 IridescenceName = Literal["rotation", "thin-film", "grating"]
 MdfName = Literal["ashikhmin", "multipeak"]
+SubstrateName = Literal["dielectric", "conductor"]
+MetalName = Literal["gold", "silver", "copper", "aluminium", "titanium", "iron", "bismuth",
+                    "artist"]
 
 Exponent = Annotated[float, Field(ge=0.0, le=1e6)]
 Frequency = Annotated[float, Field(ge=0.0, le=1000.0)]
@@ -36,7 +39,7 @@ Angle = Annotated[float, Field(ge=-TWO_PI, le=TWO_PI)]
 Weight = Annotated[float, Field(ge=0.0, le=100.0)]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 # Film and substrate indices: real (lossless) dielectrics from air up to about
-# diamond-and-beyond; absorbing substrates (metals) are out of scope.
+# diamond-and-beyond; absorbing substrates are conductors (``substrate``, ``metal``).
 FilmIor = Annotated[float, Field(ge=1.0, le=3.0)]
 SubstrateIor = Annotated[float, Field(ge=1.0, le=4.0)]
 # Thickness in nm: 0 is the bare substrate; beyond ~2 µm the colours of a film
@@ -63,6 +66,7 @@ def about(group: str, unit: str | None = None, **applies: tuple[str, ...]) -> di
 
 PHYSICAL, MATERIAL = "physical", "material"
 FILM, GRATING, ROTATION = ("thin-film",), ("grating",), ("rotation",)
+DIELECTRIC, CONDUCTOR, ARTIST = ("dielectric",), ("conductor",), ("artist",)
 
 
 class Material(BaseModel):
@@ -86,9 +90,30 @@ class Material(BaseModel):
         description="Film thickness in nm where the thickness field is 1, and everywhere "
         "without a field (KHR iridescenceThicknessMaximum), 0 … 2000.")
     substrate_ior: SubstrateIor = Field(
-        1.5, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        1.5, json_schema_extra=about(PHYSICAL, iridescence=FILM, substrate=DIELECTRIC),
         description="Refractive index under the film (water 1.33, glass 1.5, air 1 for a "
         "soap film), 1 … 4.")
+    substrate: SubstrateName = Field(
+        "dielectric", json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="What is under the film: 'dielectric' (the real index substrate_ior) or "
+        "'conductor' (a metal's n + ik per wavelength: metal). A film of thickness 0 leaves "
+        "the bare substrate.")
+    metal: MetalName = Field(
+        "gold", json_schema_extra=about(PHYSICAL, iridescence=FILM, substrate=CONDUCTOR),
+        description="The conductor under the film, from published n, k: gold, silver, copper "
+        "(Johnson & Christy 1972), aluminium (Rakić 1995), titanium, iron (Johnson & Christy "
+        "1974), bismuth (Hagemann 1975); or 'artist': metal_f0 and metal_edge_tint "
+        "(Gulbrandsen 2014).")
+    metal_f0: tuple[Unit, Unit, Unit] = Field(
+        (0.944, 0.776, 0.373),
+        json_schema_extra=about(PHYSICAL, iridescence=FILM, substrate=CONDUCTOR, metal=ARTIST),
+        description="The artist metal's reflectance at normal incidence, linear RGB, each "
+        "0 … 1.")
+    metal_edge_tint: tuple[Unit, Unit, Unit] = Field(
+        (0.998, 0.981, 0.751),
+        json_schema_extra=about(PHYSICAL, iridescence=FILM, substrate=CONDUCTOR, metal=ARTIST),
+        description="The artist metal's edge tint (Gulbrandsen 2014: its colour toward "
+        "grazing), linear RGB, each 0 … 1.")
     grating_pitch: Pitch = Field(
         1.6, json_schema_extra=about(PHYSICAL, "µm", iridescence=GRATING),
         description="Grating period in µm across the grooves (CD 1.6, DVD 0.74), 0.2 … 20.")

@@ -12,11 +12,17 @@ reflected waves gives, per polarisation,
 averaged over s and p (unpolarised light). Total internal reflection at
 either interface gives R = 1. Each function mirrors the GLSL function of the
 same name in glsl/lib/thin_film.glsl.
+
+A conductor substrate (docs/physics.md §1.2) has a complex index ñ = n + ik,
+so b = |b|·e^{iψ} is complex: its phase ψ adds to the film's, and the same sum
+is exact with b → |b| and φ → φ + ψ. Where ``n_sub`` is complex, the functions
+below take that branch; the lower interface then never reflects totally (an
+evanescent wave in a lossless medium comes out as |b| = 1, R = 1, by itself).
 """
 
 from __future__ import annotations
 
-from typing import TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -26,20 +32,26 @@ from opaline.model.microfacet import FloatArray, Values
 from opaline.model.spectrum import rgb_weights, sample_wavelengths
 
 # Per polarisation (s, p): one Fresnel amplitude coefficient each.
-Amplitudes: TypeAlias = tuple[FloatArray, FloatArray]
+# (r23 is complex under a conductor.)
+Amplitudes: TypeAlias = tuple[npt.NDArray[Any], npt.NDArray[Any]]
+# Under the film: a dielectric's real index, or a conductor's n + ik per wavelength.
+Substrate: TypeAlias = "float | npt.NDArray[np.complex128]"
 
 FAST_TERMS = 3  # Fourier terms of the fast path; |ab|^4 < 1e-3 below grazing
 
 
 def interfaces(
-    cos1: npt.ArrayLike, n_film: float, n_sub: float
-) -> tuple[FloatArray, Amplitudes, Amplitudes, FloatArray]:
-    """(cos θ2, r12 s/p, r23 s/p, tir): Fresnel amplitudes at both interfaces."""
+    cos1: npt.ArrayLike, n_film: float, n_sub: Substrate
+) -> tuple[FloatArray, Amplitudes, Amplitudes, npt.NDArray[np.bool_]]:
+    """(cos θ2, r12 s/p, r23 s/p, tir): Fresnel amplitudes at both interfaces (r23
+    complex under a conductor)."""
     cos1 = np.clip(np.asarray(cos1, dtype=np.float64), 0.0, 1.0)
     # cos²θ2 = 1 - sin²θ1/n² written as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1
     # rounds to 1 in fp32, which would turn a film of index 1 into total reflection.
     cos1_sq = cos1 * cos1
     cos2_sq = (n_film * n_film - 1.0 + cos1_sq) / (n_film * n_film)
+    if np.iscomplexobj(n_sub):
+        return _conductor_interfaces(cos1, cos2_sq, n_film, np.asarray(n_sub))
     cos3_sq = (n_sub * n_sub - 1.0 + cos1_sq) / (n_sub * n_sub)
     tir = (cos2_sq <= 0.0) | (cos3_sq <= 0.0)
     cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
@@ -51,12 +63,34 @@ def interfaces(
     return cos2, (r12s, r12p), (r23s, r23p), tir
 
 
-def _ratio(num: FloatArray, den: FloatArray) -> FloatArray:
+def _conductor_interfaces(
+    cos1: FloatArray, cos2_sq: npt.NDArray[Any], n_film: float, n_sub: npt.NDArray[np.complex128]
+) -> tuple[FloatArray, Amplitudes, Amplitudes, npt.NDArray[np.bool_]]:
+    """``interfaces`` over ñ = n + ik: ñ·cos θ3 = √(ñ² - sin²θ1) on the principal branch,
+    whose imaginary part is ≥ 0 (the wave decays into the metal for k > 0). Exactly
+    grazing light is reflected whole, as the dielectric's test for total reflection
+    has it (a = -1 there; over a lossless ñ = 1, b = 1 too and Airy's sum is 0/0)."""
+    tir = (cos2_sq <= 0.0) | (cos1 <= 0.0)
+    cos2 = np.sqrt(np.maximum(cos2_sq, 0.0))
+    n_cos3 = np.sqrt(n_sub * n_sub - 1.0 + cos1 * cos1 + 0j)
+    n_sq = n_sub * n_sub
+    r12s = _ratio(cos1 - n_film * cos2, cos1 + n_film * cos2)
+    r12p = _ratio(n_film * cos1 - cos2, n_film * cos1 + cos2)
+    r23s = _ratio(n_film * cos2 - n_cos3, n_film * cos2 + n_cos3)
+    r23p = _ratio(n_sq * cos2 - n_film * n_cos3, n_sq * cos2 + n_film * n_cos3)
+    return cos2, (r12s, r12p), (r23s, r23p), tir
+
+
+def _ratio(num: npt.NDArray[Any], den: npt.NDArray[Any]) -> npt.NDArray[Any]:
     return num / np.where(np.abs(den) > 1e-30, den, 1e-30)
 
 
-def airy(a: FloatArray, b: FloatArray, phase: FloatArray) -> FloatArray:
-    """Reflectance of one polarisation: |a + b·e^{iφ}|² / |1 + ab·e^{iφ}|²."""
+def airy(a: FloatArray, b: npt.NDArray[Any], phase: FloatArray) -> FloatArray:
+    """Reflectance of one polarisation: |a + b·e^{iφ}|² / |1 + ab·e^{iφ}|² (a real; b
+    real, or complex: |b| with its phase added to φ)."""
+    if np.iscomplexobj(b):
+        phase = phase + np.angle(b)
+        b = np.abs(b)
     ab = a * b
     c = np.cos(phase)
     # The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
@@ -66,7 +100,7 @@ def airy(a: FloatArray, b: FloatArray, phase: FloatArray) -> FloatArray:
 
 
 def film_reflectance(
-    cos1: npt.ArrayLike, lam_nm: Values, d_nm: Values, n_film: float, n_sub: float
+    cos1: npt.ArrayLike, lam_nm: Values, d_nm: Values, n_film: float, n_sub: Substrate
 ) -> FloatArray:
     """Airy reflectance averaged over s and p at wavelength ``lam_nm`` (broadcasts)."""
     cos2, (r12s, r12p), (r23s, r23p), tir = interfaces(cos1, n_film, n_sub)
@@ -76,9 +110,10 @@ def film_reflectance(
 
 
 def film_rgb_spectral(
-    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float, wavelengths: int
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: Substrate, wavelengths: int
 ) -> FloatArray:
-    """Σ_i w_i·R(λ_i): ``wavelengths`` bins over 380-780 nm, CIE 1931 to linear sRGB."""
+    """Σ_i w_i·R(λ_i): ``wavelengths`` bins over 380-780 nm, CIE 1931 to linear sRGB (a
+    conductor's ``n_sub`` has one n + ik per bin)."""
     cos1 = np.asarray(cos1, dtype=np.float64)
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
@@ -136,9 +171,41 @@ def film_tail(x_abs: npt.ArrayLike, opd_um: npt.ArrayLike, shift: npt.ArrayLike)
     return total
 
 
+def film_rgb_fast_conductor(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: npt.NDArray[np.complex128]
+) -> FloatArray:
+    """``film_rgb_fast`` over a conductor with one n + ik per channel (``n_sub``, R G B, at
+    the channels' wavelengths): each channel's series with |b| and the phase ψ of b,
+    which shifts every term, cos(m(φ + ψ)), integrated against that channel's weight."""
+    cos1 = np.asarray(cos1, dtype=np.float64)
+    channels = []
+    for c in range(3):
+        cos2, r12, r23, tir = interfaces(cos1, n_film, np.asarray(n_sub[c], np.complex128))
+        opd_um = 2e-3 * n_film * np.asarray(d_nm, dtype=np.float64) * cos2
+        total: FloatArray = np.zeros(np.shape(cos2))
+        for a, b in zip(r12, r23, strict=True):
+            b_abs = np.abs(b)
+            x = a * b_abs
+            one_minus = np.maximum(1.0 - x * x, 1e-30)
+            channel = (a * a + b_abs * b_abs - 2.0 * x * x) / one_minus
+            amp = -(1.0 - a * a) * (1.0 - b_abs * b_abs) / one_minus
+            shift = np.angle(b) + np.where(x > 0.0, np.pi, 0.0)
+            for m in range(1, FAST_TERMS + 1):
+                wave = np.asarray(visible.sensitivity(m * opd_um, m * shift))[..., c]
+                channel = channel + 2.0 * amp * np.abs(x) ** m * wave
+            channel = channel + 2.0 * amp * np.asarray(film_tail(np.abs(x), opd_um, shift))[..., c]
+            total = total + 0.5 * channel
+        channels.append(np.where(tir, 1.0, total))
+    rgb: FloatArray = np.maximum(np.stack(channels, axis=-1), 0.0)
+    return rgb
+
+
 def film_rgb(
-    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: float, wavelengths: int = 0
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: Substrate,
+    wavelengths: int = 0,
 ) -> FloatArray:
     if wavelengths > 0:
         return film_rgb_spectral(cos1, d_nm, n_film, n_sub, wavelengths)
-    return film_rgb_fast(cos1, d_nm, n_film, n_sub)
+    if np.iscomplexobj(n_sub):
+        return film_rgb_fast_conductor(cos1, d_nm, n_film, np.asarray(n_sub))
+    return film_rgb_fast(cos1, d_nm, n_film, float(n_sub))

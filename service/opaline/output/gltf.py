@@ -27,7 +27,9 @@ from opaline.output.gltf_iridescence import (
     IOR,
     IRIDESCENCE,
     add_thickness_texture,
+    base_colour_and_metallic,
     is_thin_film,
+    roughness_from_exponent,
     thickness_png,
     thin_film_extensions,
     thin_film_fields,
@@ -38,10 +40,10 @@ EXTRAS_KEY = "opaline"
 
 
 def _roughness(material: Material) -> float:
-    """A rough stand-in for viewers: the MDF's width as GGX-like roughness (no exact map)."""
+    """A rough stand-in for viewers: the MDF's width as GGX-like roughness (no exact map;
+    an A-S lobe's by its wider exponent's equivalent GGX width)."""
     if material.mdf == "ashikhmin" or material.iridescence != "rotation":  # A-S lobe
-        exponent = max(min(material.ex, material.ey), 1e-3)
-        return float(np.clip(np.sqrt(2.0 / (exponent + 2.0)), 0.02, 1.0))
+        return roughness_from_exponent(min(material.ex, material.ey))
     return float(np.clip(0.15 * (material.alpha + material.beta) / 2.0, 0.05, 1.0))
 
 
@@ -81,14 +83,14 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         views.append(gl.BufferView(buffer=0, byteOffset=len(blob), byteLength=len(raw)))
         blob += raw + b"\0" * (-len(raw) % 4)
     params = material.model_dump(mode="json")
-    # A thin film lies on a dielectric (KHR_materials_ior), whose diffuse is the base colour.
-    colour = np.asarray(params["albedo"]) * (min(material.kd, 1.0) if film else 1.0)
+    colour, metallic = list(material.albedo), material.ks / max(material.ks + material.kd, 1e-9)
+    if film:  # the base under the film: a dielectric (KHR_materials_ior) or a metal
+        colour, metallic = base_colour_and_metallic(material)
     gltf_material = gl.Material(
         name=name, doubleSided=True,
         pbrMetallicRoughness=gl.PbrMetallicRoughness(
-            baseColorFactor=[*colour.tolist(), 1.0],
-            metallicFactor=0.0 if film else float(material.ks / max(material.ks + material.kd,
-                                                                     1e-9)),
+            baseColorFactor=[*colour, 1.0],
+            metallicFactor=float(metallic),
             roughnessFactor=_roughness(material)),
         extras={EXTRAS_KEY: {"model": "Kang, Lee, Cho 2014 multi-peak anisotropic microfacet",
                              "version": __version__, "material": params,

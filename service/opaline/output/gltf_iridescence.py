@@ -4,10 +4,12 @@ Export maps a ``thin-film`` material exactly: iridescenceFactor 1 (Opaline has n
 blend between film and bare substrate), iridescenceIor = film_ior,
 iridescenceThicknessMinimum/Maximum = film_thickness_min/max (nm), and the base
 material's KHR_materials_ior ior = substrate_ior, because KHR's Airy term takes
-the base material's IOR as the medium under the film (n3), as Opaline does. The
-base is written dielectric (metallicFactor 0): Opaline's substrate is a lossless
-dielectric, and a metallic base would make KHR viewers use the base colour's
-complex Fresnel under the film instead. A preset's thickness field is written as
+the base material's IOR as the medium under the film (n3), as Opaline does. A
+dielectric substrate is written as a dielectric base (metallicFactor 0); a
+conductor (docs/physics.md §1.2) as a metallic base (metallicFactor 1, no
+KHR_materials_ior) whose colour is the metal's bare F0, which KHR viewers use as
+the metal's reflectance under the film; a metallic file imports back as the
+``artist`` metal of that F0 (edge tint white). A preset's thickness field is written as
 iridescenceThicknessTexture: 8-bit grey RGB (KHR reads G), 1/255 of the range
 per step.
 
@@ -28,13 +30,16 @@ import pygltflib as gl
 from PIL import Image
 from pydantic import ValidationError
 
+from opaline.model import metals
 from opaline.model.params import Material, MaterialFields
+from opaline.model.spectrum import rgb_weights
 
 IRIDESCENCE = "KHR_materials_iridescence"
 IOR = "KHR_materials_ior"
 # KHR_materials_iridescence's defaults (iridescenceFactor's is 0: no film).
 KHR_IOR, KHR_THICKNESS_MIN, KHR_THICKNESS_MAX = 1.3, 100.0, 400.0
 GLTF_BASE_IOR = 1.5  # glTF's dielectric base without KHR_materials_ior
+F0_WAVELENGTHS = 128  # a conductor's base colour: its bare F0, converged (docs/physics.md §1.2)
 
 
 def is_thin_film(material: Material) -> bool:
@@ -51,7 +56,20 @@ def thin_film_extensions(material: Material, thickness_texture: int | None) -> d
     }
     if thickness_texture is not None:
         film["iridescenceThicknessTexture"] = {"index": thickness_texture, "texCoord": 0}
+    if material.substrate == "conductor":  # a metallic base: no index under the film
+        return {IRIDESCENCE: film}
     return {IRIDESCENCE: film, IOR: {"ior": float(material.substrate_ior)}}
+
+
+def base_colour_and_metallic(material: Material) -> tuple[list[float], float]:
+    """The base under a film: a dielectric's diffuse colour (kd·albedo, metallic 0), or a
+    conductor's bare F0 in linear sRGB (metallic 1), the colour KHR viewers take as the
+    metal's reflectance under the film."""
+    if material.substrate == "conductor":
+        f0 = metals.bare_f0(metals.substrate_for(material, F0_WAVELENGTHS)) @ rgb_weights(
+            F0_WAVELENGTHS)
+        return [float(c) for c in np.clip(f0, 0.0, 1.0)], 1.0
+    return [float(c) * min(material.kd, 1.0) for c in material.albedo], 0.0
 
 
 def thickness_png(field: np.ndarray) -> bytes:
@@ -80,6 +98,24 @@ def _number(block: dict[str, Any], key: str, default: float) -> float:
     return float(value)
 
 
+# glTF's roughness r is perceptual: the GGX width is α = r² (glTF 2.0 spec, appendix B),
+# and the A-S (Blinn-Phong) exponent of the same width is n = 2/α² - 2 (Walter et al.
+# 2007, §5.2), so n = 2/r⁴ - 2; roughness 0.1 is n ≈ 20 000, not the 198 of r read as α.
+EXPONENT_MAX = 1e6  # Material's range
+
+
+def exponent_from_roughness(roughness: float) -> float:
+    """The A-S exponent of a glTF roughness (clamped to [0.02, 1] as importers do)."""
+    alpha = float(np.clip(roughness, 0.02, 1.0)) ** 2
+    return float(min(2.0 / alpha**2 - 2.0, EXPONENT_MAX))
+
+
+def roughness_from_exponent(exponent: float) -> float:
+    """glTF roughness of an A-S exponent: the inverse of ``exponent_from_roughness``."""
+    alpha = np.sqrt(2.0 / (max(exponent, 0.0) + 2.0))
+    return float(np.clip(np.sqrt(alpha), 0.02, 1.0))
+
+
 def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     """Request fields of a material carrying KHR_materials_iridescence (ValueError if the
     film is off or outside Opaline's ranges). The base's roughness becomes the A-S lobe's
@@ -92,11 +128,10 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     if _number(film, "iridescenceFactor", 0.0) <= 0.0:
         raise ValueError(f"{IRIDESCENCE} has iridescenceFactor 0: the film is off")
     pbr = material.pbrMetallicRoughness or gl.PbrMetallicRoughness()
-    roughness = float(np.clip(pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0,
-                              0.02, 1.0))
     metallic = pbr.metallicFactor if pbr.metallicFactor is not None else 1.0
     colour = list(pbr.baseColorFactor or [1.0, 1.0, 1.0, 1.0])[:3]
-    exponent = float(min(2.0 / roughness**2 - 2.0, 1e6))
+    exponent = exponent_from_roughness(
+        pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0)
     fields = {
         "iridescence": "thin-film",
         "film_ior": _number(film, "iridescenceIor", KHR_IOR),
@@ -107,6 +142,9 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
         "kd": float(np.clip(1.0 - metallic, 0.0, 1.0)),
         "albedo": [float(np.clip(c, 0.0, 1.0)) for c in colour],
     }
+    if metallic >= 1.0:  # a film on a metal: its base colour is the metal's F0
+        fields.update(substrate="conductor", metal="artist", kd=0.0,
+                      metal_f0=fields["albedo"], metal_edge_tint=[1.0, 1.0, 1.0])
     try:
         MaterialFields.model_validate(fields)
     except ValidationError as exc:

@@ -1,0 +1,142 @@
+// Thin film on a conductor (docs/physics.md §1.2): the substrate's index is
+// complex, ñ = n + ik, so the lower interface's amplitude b is complex for each
+// polarisation, and Airy's sum per polarisation is
+//   R = (a² + |b|² + 2a·Re(b·e^{iφ})) / (1 + a²|b|² + 2a·Re(b·e^{iφ})),
+// exact for an absorbing substrate (the film itself stays lossless, a real). The
+// metal does not reflect totally; only the film's top can (never for n ≥ 1).
+// Included by lib/thin_film.glsl for SUBSTRATE_CONDUCTOR; float64 twin:
+// opaline/model/thinfilm.py (_conductor_interfaces, film_rgb_fast_conductor).
+#ifndef THIN_FILM_CONDUCTOR_GLSL
+#define THIN_FILM_CONDUCTOR_GLSL
+
+vec2 c_mul(vec2 a, vec2 b) {
+    return vec2(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+vec2 c_div(vec2 a, vec2 b) {
+    return c_mul(a, vec2(b.x, -b.y)) / max(dot(b, b), 1e-30);
+}
+
+// Principal square root: Re ≥ 0, and Im ≥ 0 where Im z ≥ 0 (k ≥ 0: the wave decays
+// into the metal). The smaller part is found by division, not by cancellation.
+vec2 c_sqrt(vec2 z) {
+    float r = length(z);
+    if (z.x >= 0.0) {
+        float re = sqrt(0.5 * (r + z.x));
+        return vec2(re, re > 0.0 ? 0.5 * z.y / re : 0.0);
+    }
+    float im = sqrt(0.5 * (r - z.x));
+    return vec2(0.5 * abs(z.y) / im, z.y < 0.0 ? -im : im);
+}
+
+// The film's top interface (s, p), as film_interfaces; false where light cannot enter,
+// and exactly at grazing, where all is reflected (over a lossless ñ = 1 Airy is 0/0).
+bool film_top(float cos1, out float cos2, out vec2 r12) {
+    float nf = u_film_ior;
+    float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
+    cos2 = sqrt(max(cos2_sq, 0.0));
+    r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
+               film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
+    return cos2_sq > 0.0 && cos1 > 0.0;
+}
+
+// The lower interface over ñ = nk: complex r23 for s (.xy) and p (.zw), with
+// ñ·cos θ3 = √(ñ² - sin²θ1).
+vec4 film_conductor_r23(float cos1, float cos2, vec2 nk) {
+    float nf = u_film_ior;
+    vec2 n_sq = c_mul(nk, nk);
+    // (ñ² - 1) + cos²θ1, in that order, as the dielectric's cos²θ3: near grazing
+    // cos²θ1 - 1 rounds to -1 in float, which would turn ñ = 1 into a mirror.
+    vec2 n_cos3 = c_sqrt(vec2(n_sq.x - 1.0 + cos1 * cos1, n_sq.y));
+    vec2 top_s = vec2(nf * cos2, 0.0);
+    vec2 top_p = n_sq * cos2;
+    vec2 bottom_p = nf * n_cos3;
+    return vec4(c_div(top_s - n_cos3, top_s + n_cos3), c_div(top_p - bottom_p, top_p + bottom_p));
+}
+
+#if WAVELENGTHS > 0
+uniform float u_wavelength_nm[WAVELENGTHS];
+uniform vec2 u_substrate_nk[WAVELENGTHS];  // n + ik at each wavelength
+
+// One polarisation: a real, b complex, e = e^{iφ}.
+float film_airy_complex(float a, vec2 b, vec2 e) {
+    float b2 = dot(b, b);
+    float re = b.x * e.x - b.y * e.y;  // Re(b·e^{iφ})
+    return max(a * a + b2 + 2.0 * a * re, 0.0) / max(1.0 + a * a * b2 + 2.0 * a * re, 1e-30);
+}
+
+vec3 film_rgb(float cos1, float d) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    float cos2;
+    vec2 r12;
+    if (!film_top(cos1, cos2, r12)) {
+        return vec3(1.0);
+    }
+    float opd = 2.0 * u_film_ior * d * cos2;  // nm
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        vec4 r23 = film_conductor_r23(cos1, cos2, u_substrate_nk[i]);
+        // φ in cycles, reduced before the trigonometry, as the dielectric path.
+        float phase = TWO_PI * fract(opd / u_wavelength_nm[i]);
+        vec2 e = vec2(cos(phase), sin(phase));
+        float r = 0.5 * (film_airy_complex(r12.x, r23.xy, e) + film_airy_complex(r12.y, r23.zw, e));
+        sum += u_spectral_weight[i] * r;
+    }
+    return max(sum, vec3(0.0));
+}
+#else
+// Fast path: the dielectric's Fourier series (lib/thin_film.glsl) per channel, with
+// one n + ik per channel (its colour weight's average) and so one complex b per
+// channel and polarisation: |b| in the coefficients, b's phase ψ added to every
+// Gaussian's θ_k = 2π·μ_k·opd + ψ. The sign of q = -a|b| carries the π shift.
+uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
+uniform vec3 u_film_sens_centre[3];  // µm⁻¹
+uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
+uniform vec2 u_substrate_nk[3];      // n + ik per channel (R, G, B)
+
+float film_channel(int c, float cos1, float cos2, vec2 r12, float opd_um) {
+    vec4 r23 = film_conductor_r23(cos1, cos2, u_substrate_nk[c]);
+    float value = 0.0;
+    for (int pol = 0; pol < 2; ++pol) {
+        vec2 b = pol == 0 ? r23.xy : r23.zw;
+        float a = r12[pol];
+        float b_abs = length(b);
+        float psi = b_abs > 0.0 ? atan(b.y, b.x) : 0.0;
+        float q = -a * b_abs;
+        float one_minus = max(1.0 - q * q, 1e-30);
+        float amp = -(1.0 - a * a) * (1.0 - b_abs * b_abs) / one_minus;
+        value += 0.5 * (a * a + b_abs * b_abs - 2.0 * q * q) / one_minus;
+        for (int k = 0; k < 3; ++k) {
+            float c1 = cos(TWO_PI * fract(u_film_sens_centre[k][c] * opd_um) + psi);
+            float c2 = 2.0 * c1 * c1 - 1.0;
+            float c3 = c1 * (2.0 * c2 - 1.0);
+            float c4 = 2.0 * c2 * c2 - 1.0;
+            float sigma_opd = PI * u_film_sens_sigma[k][c] * opd_um;
+            float d1 = exp(-2.0 * sigma_opd * sigma_opd);
+            float d4 = (d1 * d1) * (d1 * d1);
+            float d9 = d4 * d4 * d1;
+            float d16 = d4 * d4 * d4 * d4;
+            float terms = q * c1 * d1 + q * q * c2 * d4 + q * q * q * c3 * d9;
+            float tail = q * q * q * q * (c4 - q * c3) / max(1.0 - 2.0 * q * c1 + q * q, 1e-12);
+            value += u_film_sens_weight[k][c] * amp * (terms + d16 * tail);
+        }
+    }
+    return value;
+}
+
+vec3 film_rgb(float cos1, float d) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    float cos2;
+    vec2 r12;
+    if (!film_top(cos1, cos2, r12)) {
+        return vec3(1.0);
+    }
+    float opd_um = 2e-3 * u_film_ior * d * cos2;
+    vec3 rgb = vec3(film_channel(0, cos1, cos2, r12, opd_um),
+                    film_channel(1, cos1, cos2, r12, opd_um),
+                    film_channel(2, cos1, cos2, r12, opd_um));
+    return max(rgb, vec3(0.0));
+}
+#endif
+
+#endif
