@@ -7,7 +7,7 @@ the other can serve. The replicas share a real Redis (OPALINE_STATE_URL): a mesh
 uploaded through the proxy renders on both, a turntable answers from either, and one
 whose replica is killed mid-run is finished by the other. The mesh and turntable tests
 run again on one replica with the default embedded state (no OPALINE_STATE_URL, no
-Redis). Bounded: small images, about 60 s in all on 2 cores.
+Redis). Bounded: small images, about 45 s in all on 2 cores.
 """
 
 from __future__ import annotations
