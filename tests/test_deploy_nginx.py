@@ -5,8 +5,9 @@ requests that the balancer routes to the other; 50 concurrent equal requests
 render once across both replicas; killing a replica mid-run loses no request
 the other can serve. The replicas share a real Redis (OPALINE_STATE_URL): a mesh
 uploaded through the proxy renders on both, a turntable answers from either, and one
-whose replica is killed mid-run is finished by the other. Bounded: small images, about
-40 s in all on 2 cores.
+whose replica is killed mid-run is finished by the other. The mesh and turntable tests
+run again on one replica with the default embedded state (no OPALINE_STATE_URL, no
+Redis). Bounded: small images, about 45 s in all on 2 cores.
 """
 
 from __future__ import annotations
@@ -91,6 +92,26 @@ def deployment(store):
         yield [a, b], proxy, client
 
 
+@pytest.fixture(scope="module")
+def embedded():
+    """One replica keeping its state itself (the default: nothing to install) behind nginx."""
+    need_nginx()
+    assert "OPALINE_STATE_URL" not in os.environ, "the replica would inherit a shared store"
+    with (LocalServer(env=REPLICA_ENV) as a, LocalProxy([a.base]) as proxy,
+          httpx.Client(base_url=proxy.base, trust_env=False, timeout=60) as client):
+        yield [a], proxy, client
+
+
+@pytest.fixture(params=["redis", "embedded"])
+def stateful(request):
+    """The tests of state run on both: two replicas sharing Redis, one with embedded state."""
+    return request.getfixturevalue("deployment" if request.param == "redis" else "embedded")
+
+
+def where(replicas: list[LocalServer]) -> str:
+    return "two replicas and Redis" if len(replicas) > 1 else "one replica, embedded state"
+
+
 def test_a_miss_on_one_replica_is_a_hit_routed_to_the_other(deployment):
     replicas, proxy, client = deployment
     before = [renders(r) for r in replicas]
@@ -159,17 +180,18 @@ def test_a_batch_fans_out_over_the_replicas(deployment, tmp_path):
           "run again: 12 nginx HITs, no render")
 
 
-def test_a_mesh_uploaded_through_the_proxy_renders_on_every_replica(deployment):
-    replicas, proxy, client = deployment
+def test_a_mesh_uploaded_through_the_proxy_renders_on_every_replica(stateful):
+    replicas, proxy, client = stateful
     upload = client.post("/v1/meshes", content=mesh_bytes("stl"))
     assert upload.status_code == 201, upload.text
-    paths = [f"/v1/render?preset={PRESET}&mesh={upload.json()['id']}&mu_f={1 + i / 9}"
-             "&width=48&height=48&quality=draft" for i in range(8)]
+    paths = [f"/v1/render?preset={PRESET}&mesh={upload.json()['id']}&mu_f={1 + i / 19}"
+             "&width=48&height=48&quality=draft" for i in range(20)]
     statuses = [client.get(path).status_code for path in paths]  # each a miss: round robin
-    assert statuses == [200] * 8, statuses
-    routed = {upstream(log_lines(proxy, path)[0]) for path in paths}
-    assert routed == {r.base.removeprefix("http://") for r in replicas}
-    print(f"\nshared meshes: 8 renders of an uploaded mesh, all 200, via {sorted(routed)}")
+    assert statuses == [200] * 20, statuses
+    routed = [upstream(log_lines(proxy, path)[0]) for path in paths]
+    assert set(routed) == {r.base.removeprefix("http://") for r in replicas}
+    print(f"\nmeshes on {where(replicas)}: 20 renders of an uploaded mesh, all 200, "
+          f"{[routed.count(u) for u in sorted(set(routed))]} via {sorted(set(routed))}")
 
 
 def poll_until_done(clients: list[httpx.Client], path: str) -> list[dict]:
@@ -186,8 +208,8 @@ def poll_until_done(clients: list[httpx.Client], path: str) -> list[dict]:
     return seen
 
 
-def test_a_turntable_answers_from_either_replica(deployment):
-    replicas, proxy, client = deployment
+def test_a_turntable_answers_from_either_replica(stateful):
+    replicas, proxy, client = stateful
     body = {"preset": PRESET, "frames": 6, "width": 48, "height": 48, "quality": "draft",
             "mu_f": 9.5}
     started = client.post("/v1/turntables", json=body)
@@ -201,10 +223,10 @@ def test_a_turntable_answers_from_either_replica(deployment):
     finally:
         for c in direct:
             c.close()
-    assert [r.status_code for r in results] == [200] * 3
+    assert [r.status_code for r in results] == [200] * (1 + len(replicas))
     assert len({r.content for r in results}) == 1
-    print(f"\nshared turntables: {len(seen)} polls via the proxy and both replicas, all 200; "
-          "the result fetched 200 from each")
+    print(f"\nturntables on {where(replicas)}: {len(seen)} polls via the proxy and each "
+          "replica, all 200; the result fetched 200 from each")
 
 
 def test_killing_a_replica_loses_no_request(deployment):
