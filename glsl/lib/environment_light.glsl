@@ -110,7 +110,14 @@ vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
     vec3 shift = env_pixel_shift();
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {
-        vec4 s = env_sample_half(env_sequence(u_env_pass * ENV_SAMPLES + i, shift));
+        vec3 u = env_sequence(u_env_pass * ENV_SAMPLES + i, shift);
+#if ENV_SAMPLES % 3 == 0
+        // Each of the rotation source's three lobes gets exactly a third of a pass's
+        // samples (multi-sample MIS, balance heuristic: the mixture's density is still
+        // the weight): no pass leaves a channel's lobe with one sample or none.
+        u.z = (float(i % 3) + 0.5) / 3.0;
+#endif
+        vec4 s = env_sample_half(u);
         float vh = dot(vl, s.xyz);
         vec3 ll = 2.0 * vh * s.xyz - vl;
         if (vh <= 0.0 || ll.z <= 0.0 || s.w <= 0.0) {
