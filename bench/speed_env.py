@@ -1,6 +1,6 @@
 """Environment light's cost as same-run ratios, against issue 21's targets.
 
-    python bench/speed_env.py [--rounds 5] [--per-round 6] [--presets sphere cd-rom]
+    python bench/speed_env.py [--rounds 7] [--per-round 8] [--presets sphere cd-rom]
 
 Per preset, in process (a warm ``Renderer`` + PNG encode, 256², as bench/speed.py's
 in-process rows), one image of each variant after one floor image (bench/floor/floor.py),
@@ -11,6 +11,8 @@ again and again, so every variant and the floor see the same load:
   (gl/environment_light.py), standard and draft at their tiers' ``environment_samples``;
 - standard with ``environment_samples`` 1, 2, 8 beside the tier's 4: a straight line
   through the four splits the render into a part per lobe sample and a fixed part;
+- on the sphere and cd-rom, standard at 8 wavelengths (the tier's 16 halved), key
+  light and environment: how much of a lobe sample is the spectral BRDF it evaluates;
 - on the sphere, ``environment_lights=16`` (standard's K): the median-cut path, for
   comparison.
 
@@ -41,6 +43,7 @@ AIM = 0.2  # how far inside a target the brief asks to land
 SWEEP = (1, 2, 8)  # environment_samples beside the standard tier's own (4)
 STANDARD_SAMPLES = 4  # the standard tier's environment_samples
 COMPARE_K = 16  # the standard tier's environment_lights
+WAVELENGTH_PRESETS = ("sphere", "cd-rom")
 
 
 def variants(preset: str) -> list[tuple[str, dict]]:
@@ -51,6 +54,10 @@ def variants(preset: str) -> list[tuple[str, dict]]:
             ("env draft", {"quality": "draft", **env})]
     rows += [(f"env standard samples={n}",
               {"quality": "standard", **env, "environment_samples": n}) for n in SWEEP]
+    if preset in WAVELENGTH_PRESETS:  # how much of a lobe sample is the spectral BRDF
+        rows += [(f"{kind} standard wavelengths=8",
+                  {"quality": "standard", **extra, "wavelengths": 8})
+                 for kind, extra in (("key", {}), ("env", env))]
     if preset == "sphere":
         rows.append((f"env standard K={COMPARE_K}",
                      {"quality": "standard", **env, "environment_lights": COMPARE_K}))
@@ -186,8 +193,8 @@ def markdown(result: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rounds", type=int, default=5)
-    parser.add_argument("--per-round", type=int, default=6)
+    parser.add_argument("--rounds", type=int, default=7)
+    parser.add_argument("--per-round", type=int, default=8)
     parser.add_argument("--presets", nargs="+", default=list(PRESETS))
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
