@@ -39,7 +39,7 @@ from speed import FLOOR, SIZE, Child
 PRESETS = ("sphere", "nacre-film", "oil-film", "soap-bubble", "cd-rom")
 ENVIRONMENT = "studio"
 TARGETS = {"standard_over_key": 1.5, "draft_over_floor": 3.0}
-AIM = 0.2  # how far inside a target the brief asks to land
+AIM = 0.2  # the margin aimed for: 20 % inside each target
 SWEEP = (1, 2, 8)  # environment_samples beside the standard tier's own (4)
 STANDARD_SAMPLES = 4  # the standard tier's environment_samples
 COMPARE_K = 16  # the standard tier's environment_lights
