@@ -148,6 +148,7 @@ async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     finally:
         await app.state.turntables.stop()  # before the workers: stopped, not failed
         await asyncio.to_thread(app.state.pool.stop)
+        app.state.meshes.close()  # here: uvicorn re-raises SIGTERM/SIGINT, skipping atexit
 
 
 def renderer_for(settings: Settings) -> RendererFactory:
