@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 OWNER = ".owner"
+WORKER_KINDS = ("encode", "decode")  # what render workers make: MP4s passed to ffmpeg
 # Between creating a name and locking it there are microseconds; a name this young is
 # never taken for a dead one's, even unlocked.
 YOUNG_S = 10.0
@@ -80,12 +81,13 @@ def _unlocked(path: Path) -> bool:
     return True
 
 
-def sweep(kind: str, folder: Path | None = None) -> int:
-    """Remove what dead owners left of ``kind`` in ``folder`` (the temporary directory by
+def sweep(*kinds: str, folder: Path | None = None) -> int:
+    """Remove what dead owners left of ``kinds`` in ``folder`` (the temporary directory by
     default); the number removed."""
     root = Path(folder if folder is not None else tempfile.gettempdir())
     removed = 0
-    for path in root.glob(f"opaline-{kind}-*"):
+    found = [(kind, path) for kind in kinds for path in root.glob(f"opaline-{kind}-*")]
+    for kind, path in found:
         try:
             young = time.time() - path.lstat().st_mtime < YOUNG_S
             if not _unlocked(path) or (young and _alive(_pid(path.name, kind))):

@@ -22,7 +22,7 @@ from fastapi import APIRouter, FastAPI
 from fastapi.responses import FileResponse, RedirectResponse, Response
 from pydantic import BaseModel
 
-from opaline import __version__
+from opaline import __version__, scratch
 from opaline.model.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
@@ -142,13 +142,16 @@ def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:
 @asynccontextmanager
 async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     all_presets()  # an invalid preset stops the start-up, naming the file and field
+    scratch.sweep(*scratch.WORKER_KINDS)  # a killed run's (its mesh folder: the store's)
     await asyncio.to_thread(app.state.pool.start)
     try:
         yield
     finally:
         await app.state.turntables.stop()  # before the workers: stopped, not failed
         await asyncio.to_thread(app.state.pool.stop)
-        app.state.meshes.close()  # here: uvicorn re-raises SIGTERM/SIGINT, skipping atexit
+        # Here, not at exit: uvicorn re-raises SIGTERM/SIGINT, so atexit never runs.
+        app.state.meshes.close()
+        scratch.sweep(*scratch.WORKER_KINDS)  # every worker gone: what a killed one left
 
 
 def renderer_for(settings: Settings) -> RendererFactory:

@@ -76,8 +76,8 @@ class MeshStore:
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         if settings.mesh_store_dir is not None:
-            self._closer = weakref.finalize(self, scratch.sweep, "upload", self.root)
-            scratch.sweep("upload", self.root)  # uploads a killed run was receiving
+            self._closer = weakref.finalize(self, scratch.sweep, "upload", folder=self.root)
+            scratch.sweep("upload", folder=self.root)  # uploads a killed run was receiving
         self.budget = settings.mesh_store_bytes
         self.max_file = settings.mesh_max_bytes
         self.folder = settings.meshes_dir
