@@ -166,7 +166,7 @@ def renderer_for(settings: Settings) -> RendererFactory:
 def open_state(settings: Settings) -> StateStore:
     """The store ``settings.state_url`` names: this process's memory when unset."""
     if settings.state_url is None:
-        return LocalState(settings.mesh_store_bytes)
+        return LocalState(settings.mesh_store_bytes, settings.turntable_result_bytes)
     from opaline.server.redisstate import RedisState  # the redis package only when used
 
     return RedisState(settings.state_url, settings.mesh_store_bytes,

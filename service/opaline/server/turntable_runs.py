@@ -34,7 +34,7 @@ Tasks = list[tuple[str, ImageTask]]
 
 class TurntableStatus(BaseModel):
     id: str
-    state: str  # running, done, failed
+    state: str  # running, done, failed, cancelled
     done: int
     frames: int
     error: str | None = None
@@ -114,7 +114,7 @@ async def start(svc: Service, found: Turntables, value: dict[str, Any], expect: 
         return None
     task = asyncio.create_task(run(svc, found, job, tasks, body.fps, shared))
     found.running[job.id] = (job, task)
-    task.add_done_callback(lambda _: found.running.pop(job.id, None))
+    task.add_done_callback(lambda done: found.forget(job.id, done))
     return Record(job.version, job.value)
 
 
@@ -135,13 +135,17 @@ async def adopt(svc: Service, found: Turntables, record: Record,
     return started or await found.read(value["id"]) or record
 
 
+def unknown_line(turntable_id: str) -> str:
+    return (f"turntable {turntable_id!r} is not known here: start it with "
+            "POST /v1/turntables (finished ones are forgotten after 64)")
+
+
 async def current(svc: Service, found: Turntables, turntable_id: str,
                   shared: asyncio.Semaphore) -> dict[str, Any]:
     """The job's record as it stands, after taking it over if it was orphaned."""
     record = await found.read(turntable_id)
     if record is None:
-        raise UnknownTurntable(f"turntable {turntable_id!r} is not known here: start it with "
-                               "POST /v1/turntables (finished ones are forgotten after 64)")
+        raise UnknownTurntable(unknown_line(turntable_id))
     if found.orphaned(record):
         record = await adopt(svc, found, record, shared)
     return record.value
