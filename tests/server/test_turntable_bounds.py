@@ -101,3 +101,37 @@ def test_running_turntables_survive_new_ones_and_delete_cancels(backend):
         full = client.post("/v1/turntables", json=tiny(3))
         assert full.status_code == 429 and full.json()["error"] == "busy", full.text
         assert "retry-after" in full.headers
+
+
+def test_an_encode_is_priced_by_its_frames_size_and_format():
+    import io
+
+    from PIL import Image
+
+    from opaline.output.animation import encode_cost_s
+    from opaline.workers.animation_task import AnimationTask
+
+    png = io.BytesIO()
+    Image.new("RGB", (64, 32)).save(png, format="PNG")
+    task = AnimationTask((png.getvalue(),) * 10, "mp4", 24)
+    assert task.units()[3] == encode_cost_s(10, 64, 32, "mp4") > 0  # counted as work ahead
+    assert encode_cost_s(360, 860, 860, "mp4") > 10 * encode_cost_s(36, 256, 256, "mp4")
+
+
+@pytest.mark.gl
+def test_the_largest_legal_turntable_is_refused_at_once_if_its_encode_cannot_finish(backend):
+    """360 frames at 860² used to render every frame, then die in the encode at the 30 s
+    watchdog on every retry; its encode is now priced at admission."""
+    settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1)
+    largest = {"preset": "sphere", "frames": 360, "width": 860, "height": 860,
+               "quality": "draft", "wavelengths": 0}  # 798,768,000 of the 805,306,368 budget
+    with TestClient(create_app(settings)) as client:
+        for fmt in ("mp4", "webp"):
+            started = time.monotonic()
+            answer = client.post("/v1/turntables", json={**largest, "animation": fmt})
+            assert answer.status_code == 422 and answer.json()["error"] == "too_slow", answer.text
+            assert "encoding the 360 frames" in answer.json()["detail"][0]
+            assert time.monotonic() - started < 2.0
+        small = client.post("/v1/turntables", json={**tiny(0), "animation": "mp4"})
+        assert small.status_code == 202, small.text
+        wait_for(client, small.json()["id"], "done")

@@ -19,13 +19,14 @@ from pydantic import BaseModel
 from opaline.errors import PublicError
 from opaline.model.request import content_key
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
+from opaline.output.animation import encode_cost_s
 from opaline.pipeline.prepare import prepare
 from opaline.server.errors import UnknownTurntable
 from opaline.server.queries import parse_body
 from opaline.server.service import Service
 from opaline.server.statestore import Record, StoreUnavailable
 from opaline.server.turntable_jobs import Job, Lost, Turntables
-from opaline.workers.animation_task import AnimationTask
+from opaline.workers.animation_task import ENCODE_LABEL, AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
 
@@ -99,6 +100,13 @@ def plan(svc: Service, raw: bytes) -> tuple[TurntableRequest, Tasks, str]:
         raise TooSlow(f"each frame is predicted to take {predicted:.1f} s, over the "
                       f"{svc.settings.deadline_s:g} s limit: lower width, height, samples or "
                       "wavelengths (or choose a lower quality)")
+    job = still.job
+    encoding = svc.pool.cost.predict(ENCODE_LABEL, 0.0, 0, encode_cost_s(
+        body.frames, job.width, job.height, body.animation))
+    if encoding > svc.settings.deadline_s:  # admission would refuse it after every frame
+        raise TooSlow(f"encoding the {body.frames} frames as {body.animation} is predicted to "
+                      f"take {encoding:.1f} s, over the {svc.settings.deadline_s:g} s limit: "
+                      "lower frames, width or height (or choose gif, the fastest to encode)")
     key = content_key({"frames": [k for k, _ in tasks], "fmt": body.animation, "fps": body.fps})
     return body, tasks, key
 
