@@ -17,7 +17,7 @@ RANKS = {
     # The package top's own body defines only __version__, which any module may import.
     "opaline": 0,
     "opaline.settings": 0, "opaline.setting_defaults": 0, "opaline.service_settings": 0,
-    "opaline.resources": 0, "opaline.lru": 0, "opaline.errors": 0,
+    "opaline.resources": 0, "opaline.lru": 0, "opaline.errors": 0, "opaline.scratch": 0,
     "opaline.scene": 1,
     "opaline.model": 2,
     "opaline.gl": 3, "opaline.output": 3,

@@ -126,6 +126,11 @@ class Settings(BaseSettings):
                     "continued by the replica that next answers for it.")
     turntable_keep_s: int = Field(
         3600, ge=1, description="How long a turntable's status and result are kept.")
+    turntable_result_bytes: int = Field(
+        64 * 1024 * 1024, ge=1024,
+        description="Bytes of finished turntables' animations kept in this process (without "
+                    "OPALINE_STATE_URL), the oldest forgotten first; part of the HTTP "
+                    "process's 256 MB in the memory budget.")
     meshes_dir: Path | None = Field(
         None, description="A folder of mesh files requests may name by file name (mesh=NAME).")
     environments_dir: Path | None = Field(

@@ -22,7 +22,7 @@ from fastapi import APIRouter, FastAPI
 from fastapi.responses import FileResponse, RedirectResponse, Response
 from pydantic import BaseModel
 
-from opaline import __version__
+from opaline import __version__, scratch
 from opaline.model.camera import key_light_direction
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, all_presets, get_preset
@@ -142,12 +142,16 @@ def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:
 @asynccontextmanager
 async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     all_presets()  # an invalid preset stops the start-up, naming the file and field
+    scratch.sweep(*scratch.WORKER_KINDS)  # a killed run's (its mesh folder: the store's)
     await asyncio.to_thread(app.state.pool.start)
     try:
         yield
     finally:
         await app.state.turntables.stop()  # before the workers: stopped, not failed
         await asyncio.to_thread(app.state.pool.stop)
+        # Here, not at exit: uvicorn re-raises SIGTERM/SIGINT, so atexit never runs.
+        app.state.meshes.close()
+        scratch.sweep(*scratch.WORKER_KINDS)  # every worker gone: what a killed one left
 
 
 def renderer_for(settings: Settings) -> RendererFactory:
@@ -162,7 +166,7 @@ def renderer_for(settings: Settings) -> RendererFactory:
 def open_state(settings: Settings) -> StateStore:
     """The store ``settings.state_url`` names: this process's memory when unset."""
     if settings.state_url is None:
-        return LocalState(settings.mesh_store_bytes)
+        return LocalState(settings.mesh_store_bytes, settings.turntable_result_bytes)
     from opaline.server.redisstate import RedisState  # the redis package only when used
 
     return RedisState(settings.state_url, settings.mesh_store_bytes,

@@ -19,6 +19,7 @@ from pydantic import BaseModel, Field
 
 from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, Problem
+from opaline.server.mesh_upload import receive_mesh
 from opaline.server.meshstore import InvalidMesh
 from opaline.server.render_routes import client_gone
 from opaline.workers.errors import InvalidInput
@@ -52,12 +53,8 @@ MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
                  "application/octet-stream": {"schema": {"type": "string",
                                                          "format": "binary"}}}}})
 async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
-    data = await request.body()
-    if not data:
-        raise InvalidMesh("empty body: send the mesh file (glTF/GLB, OBJ, PLY or STL) "
-                          "as the request body")
     store = svc.meshes
-    mesh_id = store.put(data)
+    mesh_id = await receive_mesh(request, store)  # streamed to disk, never whole in memory
     max_triangles = svc.settings.mesh_max_triangles
     task = MeshCheckTask(str(store.path_of(mesh_id)), max_triangles)
     try:

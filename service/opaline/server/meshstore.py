@@ -16,14 +16,14 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import shutil
-import tempfile
 import threading
 import time
 import weakref
 from collections import OrderedDict
+from collections.abc import Callable
 from pathlib import Path
 
+from opaline import scratch
 from opaline.errors import PublicError
 from opaline.model.meshes import file_digest, mesh_preset
 from opaline.model.presets import Preset
@@ -67,11 +67,17 @@ class MeshStore:
     def __init__(self, settings: Settings, shared: StateStore | None = None) -> None:
         self.shared = shared if shared is not None and shared.shared else None
         root = settings.mesh_store_dir
-        if root is None:  # a private folder, removed with the store (or at exit)
-            root = Path(tempfile.mkdtemp(prefix="opaline-meshes-"))
-            weakref.finalize(self, shutil.rmtree, root, True)
+        self._closer: Callable[[], object]
+        if root is None:  # a private folder, removed at shutdown (``close``) or at exit;
+            # one a killed run left is swept here, by the next store to start
+            scratch.sweep("meshes")
+            lock, root = scratch.owned_dir("meshes")
+            self._closer = weakref.finalize(self, scratch.release, lock, root)
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
+        if settings.mesh_store_dir is not None:
+            self._closer = weakref.finalize(self, scratch.sweep, "upload", folder=self.root)
+            scratch.sweep("upload", folder=self.root)  # uploads a killed run was receiving
         self.budget = settings.mesh_store_bytes
         self.max_file = settings.mesh_max_bytes
         self.folder = settings.meshes_dir
@@ -94,6 +100,11 @@ class MeshStore:
     def path_of(self, mesh_id: str) -> Path:
         return self.root / f"{mesh_id}{SUFFIX}"
 
+    def close(self) -> None:
+        """Remove the private folder (or, in a configured one, uploads still arriving): the
+        lifespan's shutdown calls this, since a signal's exit skips ``atexit``."""
+        self._closer()
+
     def put(self, data: bytes) -> str:
         """Store ``data`` (atomically) and answer its id; the newest is never evicted."""
         if len(data) > self.max_file:
@@ -105,17 +116,33 @@ class MeshStore:
         self._keep(mesh_id, data)
         return mesh_id
 
-    def _keep(self, mesh_id: str, data: bytes) -> None:
+    def put_file(self, path: Path, mesh_id: str) -> str:
+        """Store the file at ``path`` (an upload spooled in ``root``, moved, not copied) as
+        ``mesh_id``, the digest of its bytes; the newest is never evicted."""
+        if self.shared is not None:  # the store's interface takes bytes: one copy, briefly
+            self.shared.put(f"mesh:{mesh_id}", path.read_bytes())
         with self._lock:
-            path = self.path_of(mesh_id)
             if mesh_id not in self._sizes:
-                fd, tmp = tempfile.mkstemp(dir=self.root, suffix=".part")
-                with os.fdopen(fd, "wb") as stream:
-                    stream.write(data)
-                os.replace(tmp, path)
-                self._sizes[mesh_id] = len(data)
+                size = path.stat().st_size
+                os.replace(path, self.path_of(mesh_id))
+                self._sizes[mesh_id] = size
             self._touch(mesh_id)
             self._evict(keep=mesh_id)
+        return mesh_id
+
+    def _keep(self, mesh_id: str, data: bytes) -> None:
+        fd, tmp = scratch.owned_file("upload", ".part", self.root)
+        try:
+            with os.fdopen(os.dup(fd), "wb") as stream:
+                stream.write(data)
+            with self._lock:
+                if mesh_id not in self._sizes:
+                    os.replace(tmp, self.path_of(mesh_id))
+                    self._sizes[mesh_id] = len(data)
+                self._touch(mesh_id)
+                self._evict(keep=mesh_id)
+        finally:
+            scratch.release(fd, tmp)
 
     def discard(self, mesh_id: str) -> None:
         """Forget a mesh the worker refused, so an invalid file never takes space."""

@@ -58,25 +58,41 @@ class StateStore(Protocol):
                    ttl_s: float) -> int | None: ...
 
 
+class StoreFull(PublicError):
+    """Every record kept is a running job's: a new one would evict one (429)."""
+
+    status, reason, retry_later = 429, "busy", True
+
+
+def running(record: Record) -> bool:
+    """A running job's record: never evicted to make room (its job would stop)."""
+    return record.value.get("state") == "running"
+
+
 class LocalState:
-    """This process's memory: bounded by count (``KEPT``) and lifetime, lost at exit."""
+    """This process's memory: bounded by count (``KEPT``), lifetime and, for the bytes,
+    ``bytes_budget`` (the newest value kept even alone over it); lost at exit."""
 
     shared = False
 
-    def __init__(self, budget: int) -> None:
+    def __init__(self, budget: int, bytes_budget: int | None = None) -> None:
         self.budget = budget
+        self.bytes_budget = budget if bytes_budget is None else bytes_budget
         self._bytes: OrderedDict[str, tuple[bytes, float]] = OrderedDict()
         self._records: OrderedDict[str, tuple[Record, float]] = OrderedDict()
+        self._total = 0  # bytes of the values in _bytes
 
     @staticmethod
     def _live(found: tuple[V, float] | None) -> V | None:
         return None if found is None or found[1] < time.monotonic() else found[0]
 
     def put(self, key: str, data: bytes, ttl_s: float | None = None) -> None:
+        self.delete(key)
         self._bytes[key] = (data, time.monotonic() + (ttl_s or float("inf")))
-        self._bytes.move_to_end(key)
-        while len(self._bytes) > KEPT:
-            self._bytes.popitem(last=False)
+        self._total += len(data)
+        while len(self._bytes) > 1 and (len(self._bytes) > KEPT
+                                        or self._total > self.bytes_budget):
+            self._total -= len(self._bytes.popitem(last=False)[1][0])
 
     def get(self, key: str) -> bytes | None:
         return self._live(self._bytes.get(key))
@@ -85,7 +101,9 @@ class LocalState:
         return self.get(key) is not None
 
     def delete(self, key: str) -> None:
-        self._bytes.pop(key, None)
+        found = self._bytes.pop(key, None)
+        if found is not None:
+            self._total -= len(found[0])
 
     def record(self, key: str) -> Record | None:
         return self._live(self._records.get(key))
@@ -95,8 +113,19 @@ class LocalState:
         found = self.record(key)
         if (found.version if found else 0) != expect:
             return None
+        if key not in self._records and len(self._records) >= KEPT:
+            self._forget_one()
         self._records[key] = (Record(expect + 1, value), time.monotonic() + ttl_s)
         self._records.move_to_end(key)
-        while len(self._records) > KEPT:  # a running turntable forgotten here stops itself
-            self._records.popitem(last=False)
         return expect + 1
+
+    def _forget_one(self) -> None:
+        """Make room for a record: the oldest expired or finished one goes; a running
+        one never (its job would stop itself), so with only those kept: StoreFull."""
+        now = time.monotonic()
+        for key, (record, until) in self._records.items():
+            if until < now or not running(record):
+                del self._records[key]
+                return
+        raise StoreFull(f"{len(self._records)} turntables are running, the most this "
+                        "service keeps: retry when one has finished")

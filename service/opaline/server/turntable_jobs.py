@@ -61,6 +61,11 @@ def failure_of(exc: Exception) -> dict[str, Any]:
             "fields": exc.field_problems()}
 
 
+CANCELLED = {"status": 409, "reason": "cancelled", "retry_later": False, "retry_after_s": None,
+             "lines": ["the turntable was cancelled (DELETE): POST it again to start it anew"],
+             "fields": []}
+
+
 def new_job(job_id: str, body: str, frames: int, fmt: str) -> dict[str, Any]:
     return {"id": job_id, "body": body, "frames": frames, "fmt": fmt, "done": 0,
             "state": "running", "error": None, "failure": None, "owner": "", "lease_until": 0.0}
@@ -131,6 +136,28 @@ class Turntables:
                               failure=failure_of(exc))
         except Exception as lost:  # noqa: BLE001 (Lost, or the store down: the lease runs out)
             LOG.warning("turntable %s: its failure was not written (%s)", job.id, lost)
+
+    async def cancel(self, job_id: str) -> Record | None:
+        """Mark the job cancelled and drop its result; None if unknown. Its owner, here or
+        on another replica, finds its record changed at its next write (Lost) and stops."""
+        key = f"turntable:{job_id}"
+        record = await self.read(job_id)
+        while record is not None and record.value["state"] != "cancelled":
+            value = {**record.value, "state": "cancelled", "error": "cancelled",
+                     "failure": CANCELLED, "lease_until": 0.0}
+            version = await self.call(self.store.put_record, key, value, record.version,
+                                      self.keep_s)
+            record = Record(version, value) if version is not None else await self.read(job_id)
+        local = self.running.pop(job_id, None)
+        if local is not None:  # out of the count now: a new one may start at once
+            local[1].cancel()
+        await self.call(self.store.delete, f"{key}:result")
+        return record
+
+    def forget(self, job_id: str, task: asyncio.Task[None]) -> None:
+        """``task`` ended: no longer running here (unless a newer run of the id is)."""
+        if self.running.get(job_id, (None, None))[1] is task:
+            del self.running[job_id]
 
     async def stop(self) -> None:
         """At shutdown: stop this replica's jobs and give up their leases, so that another

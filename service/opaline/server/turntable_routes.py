@@ -1,13 +1,13 @@
-"""Turntables over HTTP: POST /v1/turntables starts one, GET says how far it is, and
-GET .../result answers the animation, from any replica (``turntable_runs`` renders
-them, ``turntable_jobs`` keeps them in the state store).
+"""Turntables over HTTP: POST /v1/turntables starts one, GET says how far it is,
+GET .../result answers the animation and DELETE cancels it, from any replica
+(``turntable_runs`` renders them, ``turntable_jobs`` keeps them in the state store).
 
 Each frame is an ordinary render job (cached, deduplicated, admitted, run by
 the workers); a worker then encodes the frames. The cost budget covers all
 frames. Progress is the count of finished frames. At most ``max_turntables`` run
 at once on a replica (one more is 429 ``busy`` with Retry-After).
 Failures answer in the public shape: 404 ``unknown_turntable``, 409
-``rendering``, and a failed turntable's result answers its failure's own
+``rendering`` (or ``cancelled``), and a failed turntable's result answers its failure's own
 status (422 ``too_slow``, 503 ``deadline`` ...); a state store that does not
 answer is 503 ``store_unavailable``.
 """
@@ -27,10 +27,19 @@ from opaline.server.errors import (
     Busy,
     Problem,
     StillRendering,
+    UnknownTurntable,
 )
 from opaline.server.render_routes import RENDER_RESPONSES
-from opaline.server.turntable_jobs import StoredFailure, new_job
-from opaline.server.turntable_runs import TurntableStatus, current, plan, start, status_of
+from opaline.server.statestore import Record
+from opaline.server.turntable_jobs import StoredFailure, Turntables, new_job
+from opaline.server.turntable_runs import (
+    TurntableStatus,
+    current,
+    plan,
+    start,
+    status_of,
+    unknown_line,
+)
 
 router = APIRouter()
 __all__ = ["TurntableStatus", "router"]
@@ -40,16 +49,21 @@ RENDER_404 = RENDER_RESPONSES[404]
 BUSY = {"model": Problem, "headers": RETRY_AFTER,
         "description": "error 'busy': as many turntables as the service runs at once are "
                        "rendering; retry after Retry-After seconds."}
-UNKNOWN = {"model": Problem, "description": "error 'unknown_turntable': never started here, "
-                                            "or forgotten (the service keeps the latest 64)."}
+UNKNOWN_LINE = ("error 'unknown_turntable': never started here, or forgotten (the service "
+                "keeps the latest 64).")
+UNKNOWN = {"model": Problem, "description": UNKNOWN_LINE}
 RESULT_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The animation: animated WebP, GIF or MP4.",
           "content": {t: {"schema": {"type": "string", "format": "binary"}}
                       for t in MEDIA_TYPES.values()}},
     **ERROR_RESPONSES,
-    404: UNKNOWN,
+    404: {"model": Problem, "description": UNKNOWN_LINE + " Also: its animation "
+                                           "was forgotten (a byte budget keeps the latest); "
+                                           "POST it again."},
     409: {"model": Problem, "description": "error 'rendering': the frames are not all done yet; "
-                                           "GET /v1/turntables/{id} tells how far it is."},
+                                           "GET /v1/turntables/{id} tells how far it is. "
+                                           "error 'cancelled': DELETE cancelled it; POST it "
+                                           "again to start it anew."},
     422: {"model": Problem, "description": "The turntable failed: a frame is over the "
                                            "service's limits (too_slow)."},
     503: {"model": Problem, "headers": RETRY_AFTER,
@@ -72,7 +86,7 @@ async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep
     planned = plan(svc, raw)
     body, _, key = planned
     record = await found.read(key)
-    while record is None or record.value["state"] == "failed" or found.orphaned(record):
+    while record is None or await restartable(found, record):
         if len(found.running) >= svc.settings.max_turntables:
             raise Busy(f"{len(found.running)} turntables are rendering, the most this service "
                        "runs at once", retry_after_s=svc.settings.deadline_s)
@@ -80,6 +94,25 @@ async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep
         record = (await start(svc, found, value, record.version if record else 0, shared,
                               planned)
                   or await found.read(key))  # or another replica started it first
+    return status_of(record.value)
+
+
+async def restartable(found: Turntables, record: Record) -> bool:
+    """Whether a POST starts the job anew: it failed, was cancelled, was orphaned, or its
+    animation was forgotten (over the kept results' byte budget)."""
+    state = record.value["state"]
+    if state == "done":
+        return await found.result(record.value["id"]) is None
+    return state in ("failed", "cancelled") or found.orphaned(record)
+
+
+@router.delete("/v1/turntables/{turntable_id}", tags=["turntables"], status_code=202,
+               responses={**ERROR_RESPONSES, 404: UNKNOWN},
+               summary="Cancel a turntable: it stops, and GET then says cancelled")
+async def turntable_delete(turntable_id: str, found: TurntablesDep) -> TurntableStatus:
+    record = await found.cancel(turntable_id)
+    if record is None:
+        raise UnknownTurntable(unknown_line(turntable_id))
     return status_of(record.value)
 
 
@@ -97,9 +130,12 @@ async def turntable_get(turntable_id: str, svc: ServiceDep, found: TurntablesDep
 async def turntable_result(turntable_id: str, svc: ServiceDep, found: TurntablesDep,
                            shared: LanesDep) -> Response:
     entry = await current(svc, found, turntable_id, shared)
-    if entry["state"] == "failed" and entry["failure"] is not None:
+    if entry["state"] in ("failed", "cancelled") and entry["failure"] is not None:
         raise StoredFailure(entry["failure"])  # its own public status and reason
     data = await found.result(turntable_id) if entry["state"] == "done" else None
+    if data is None and entry["state"] == "done":
+        raise UnknownTurntable(f"turntable {turntable_id!r}'s animation was forgotten (the "
+                               "service keeps a byte budget of them): POST it again")
     if data is None:
         raise StillRendering(f"still rendering: {entry['done']} of {entry['frames']} frames "
                              "done")

@@ -19,13 +19,14 @@ from pydantic import BaseModel
 from opaline.errors import PublicError
 from opaline.model.request import content_key
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
+from opaline.output.animation import encode_cost_s
 from opaline.pipeline.prepare import prepare
 from opaline.server.errors import UnknownTurntable
 from opaline.server.queries import parse_body
 from opaline.server.service import Service
 from opaline.server.statestore import Record, StoreUnavailable
 from opaline.server.turntable_jobs import Job, Lost, Turntables
-from opaline.workers.animation_task import AnimationTask
+from opaline.workers.animation_task import ENCODE_LABEL, AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
 
@@ -34,7 +35,7 @@ Tasks = list[tuple[str, ImageTask]]
 
 class TurntableStatus(BaseModel):
     id: str
-    state: str  # running, done, failed
+    state: str  # running, done, failed, cancelled
     done: int
     frames: int
     error: str | None = None
@@ -99,6 +100,13 @@ def plan(svc: Service, raw: bytes) -> tuple[TurntableRequest, Tasks, str]:
         raise TooSlow(f"each frame is predicted to take {predicted:.1f} s, over the "
                       f"{svc.settings.deadline_s:g} s limit: lower width, height, samples or "
                       "wavelengths (or choose a lower quality)")
+    job = still.job
+    encoding = svc.pool.cost.predict(ENCODE_LABEL, 0.0, 0, encode_cost_s(
+        body.frames, job.width, job.height, body.animation))
+    if encoding > svc.settings.deadline_s:  # admission would refuse it after every frame
+        raise TooSlow(f"encoding the {body.frames} frames as {body.animation} is predicted to "
+                      f"take {encoding:.1f} s, over the {svc.settings.deadline_s:g} s limit: "
+                      "lower frames, width or height (or choose gif, the fastest to encode)")
     key = content_key({"frames": [k for k, _ in tasks], "fmt": body.animation, "fps": body.fps})
     return body, tasks, key
 
@@ -114,7 +122,7 @@ async def start(svc: Service, found: Turntables, value: dict[str, Any], expect: 
         return None
     task = asyncio.create_task(run(svc, found, job, tasks, body.fps, shared))
     found.running[job.id] = (job, task)
-    task.add_done_callback(lambda _: found.running.pop(job.id, None))
+    task.add_done_callback(lambda done: found.forget(job.id, done))
     return Record(job.version, job.value)
 
 
@@ -135,13 +143,17 @@ async def adopt(svc: Service, found: Turntables, record: Record,
     return started or await found.read(value["id"]) or record
 
 
+def unknown_line(turntable_id: str) -> str:
+    return (f"turntable {turntable_id!r} is not known here: start it with "
+            "POST /v1/turntables (finished ones are forgotten after 64)")
+
+
 async def current(svc: Service, found: Turntables, turntable_id: str,
                   shared: asyncio.Semaphore) -> dict[str, Any]:
     """The job's record as it stands, after taking it over if it was orphaned."""
     record = await found.read(turntable_id)
     if record is None:
-        raise UnknownTurntable(f"turntable {turntable_id!r} is not known here: start it with "
-                               "POST /v1/turntables (finished ones are forgotten after 64)")
+        raise UnknownTurntable(unknown_line(turntable_id))
     if found.orphaned(record):
         record = await adopt(svc, found, record, shared)
     return record.value

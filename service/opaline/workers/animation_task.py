@@ -6,13 +6,14 @@ cache holds), so a repeated turntable costs one encode and no render."""
 from __future__ import annotations
 
 import io
+import struct
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from PIL import Image
 
-from opaline.output.animation import encode
+from opaline.output.animation import encode, encode_cost_s
 from opaline.workers.tasks import StopCheck
 
 ENCODE_LABEL = "animation"
@@ -29,5 +30,9 @@ class AnimationTask:
         frames = [np.asarray(Image.open(io.BytesIO(png)).convert("RGB")) for png in self.frames]
         return encode(frames, self.fmt, self.fps)
 
-    def units(self) -> tuple[str, float, int]:
-        return ENCODE_LABEL, 0.0, 0
+    def units(self) -> tuple[str, float, int, float]:
+        """The encode's own predicted seconds (``encode_cost_s``): counted as work ahead."""
+        first = self.frames[0] if self.frames else b""
+        # a PNG's size is in its header (IHDR, bytes 16-24)
+        width, height = struct.unpack(">II", first[16:24]) if len(first) >= 24 else (0, 0)
+        return ENCODE_LABEL, 0.0, 0, encode_cost_s(len(self.frames), width, height, self.fmt)
