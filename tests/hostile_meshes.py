@@ -104,3 +104,17 @@ def stl_solids(solids: int = 200_000) -> bytes:
     one = (b"solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
            b"vertex 0 1 0\nendloop\nendfacet\nendsolid s\n")
     return one * solids
+
+
+# Each file, and the words its refusal must contain.
+HOSTILE = {
+    "glb-3e7-vertices-no-buffer": (glb_claiming_vertices, "limit of 6000000"),
+    "gltf-200000-instances": (gltf_instanced, "limit of 1000"),
+    "ascii-ply-1.5M-undeclared-lines": (lambda: ply_with_lines(1_500_000),
+                                        "limit of two a row"),
+    "ascii-stl-200000-solids": (stl_solids, "limit of"),
+    "ascii-stl-300-solids": (lambda: stl_solids(300), "limit of 256 solids"),
+    "gltf-json-nested-100000-deep": (
+        lambda: b'{"asset":{"version":"2.0"},"extras":' + b"[" * 100_000 + b"]" * 100_000
+        + b"}", "nested too deeply"),
+}

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 import hostile_meshes as hostile
+from hostile_meshes import HOSTILE
 
 # Peak RSS of a process that imported trimesh and parsed the file: about 90 MB before any
 # file (the interpreter, NumPy, trimesh). Before these checks the files below took it to
@@ -51,17 +52,6 @@ def parse_elsewhere(tmp_path: Path, data: bytes) -> dict:
     return json.loads(done.stdout.splitlines()[-1])
 
 
-HOSTILE = {
-    "glb-3e7-vertices-no-buffer": (hostile.glb_claiming_vertices, "limit of 6000000"),
-    "gltf-200000-instances": (hostile.gltf_instanced, "limit of 1000"),
-    "ascii-ply-1.5M-undeclared-lines": (lambda: hostile.ply_with_lines(1_500_000),
-                                        "limit of two a row"),
-    "ascii-stl-200000-solids": (hostile.stl_solids, "limit of"),
-    "ascii-stl-300-solids": (lambda: hostile.stl_solids(300), "limit of 256 solids"),
-    "gltf-json-nested-100000-deep": (
-        lambda: b'{"asset":{"version":"2.0"},"extras":' + b"[" * 100_000 + b"]" * 100_000
-        + b"}", "nested too deeply"),
-}
 
 
 @pytest.mark.parametrize("name", sorted(HOSTILE))

@@ -155,7 +155,7 @@ def test_hostile_uploads_get_422_at_once_and_the_worker_stays_small(backend, tmp
     alone took it to 4 GB), the service ready and rendering."""
     import time
 
-    from test_mesh_limits import HOSTILE
+    from hostile_meshes import HOSTILE
 
     settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
                         mesh_store_dir=tmp_path)
