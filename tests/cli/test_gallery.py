@@ -84,7 +84,7 @@ def test_gallery_renders_measures_and_sheets_a_subset(capsys, tmp_path):
     assert written["presets"] == ["preset-sphere.png", "preset-soap-bubble.png"]
     lighting = {r["image"]: r["lighting"] for r in written["measured"]}
     assert lighting == {"preset-sphere.png": "preset lights",
-                        "preset-soap-bubble.png": "preset lights",
+                        "preset-soap-bubble.png": "studio",  # the preset names it
                         "studio-sphere.png": "studio", "studio-soap-bubble.png": "studio",
                         "bunny-oil-film-studio.png": "studio",
                         "bunny-oil-film-default.png": MESH_ENVIRONMENT}

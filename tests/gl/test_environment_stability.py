@@ -45,7 +45,7 @@ def environments(renderer, tmp_path_factory):
     folder = tmp_path_factory.mktemp("environments")
     names = {name: write_environment(folder, name) for name in ENVIRONMENT_MAPS}
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(renderer.backgrounds, "environments_dir", folder)
+        patch.setattr(renderer.environments, "environments_dir", folder)
         patch.setattr(renderer.surface, "environments_dir", folder)
         yield names
 

@@ -22,7 +22,7 @@ import math
 import numpy as np
 import pytest
 
-from opaline.gl.background import Backgrounds
+from opaline.gl.environment_maps import EnvironmentMaps
 from opaline.model import irradiance as irr
 from opaline.model import lobe_sampling as ls
 from opaline.model.params import Material
@@ -143,7 +143,8 @@ def test_irradiance_agrees(renderer, name, rotation, intensity):
     d = np.random.default_rng(5).normal(size=(512, 3))
     n = as_f32(np.concatenate([d / np.linalg.norm(d, axis=1, keepdims=True),
                                np.eye(3), -np.eye(3)]))
-    environment = (renderer.backgrounds.texture(name), renderer.backgrounds.irradiance(name))
+    uploaded = renderer.environments.get(name)
+    environment = (uploaded.texture, uploaded.irradiance)
     gl = renderer.probes.lobe(material(10.0, 10.0), "irradiance", (n,), environment,
                               rotation=rotation, intensity=intensity)[0][:, :3]
     c, s = math.cos(rotation), math.sin(rotation)
@@ -158,9 +159,10 @@ def test_irradiance_of_a_users_constant_map(renderer, tmp_path):
     import cv2
 
     cv2.imwrite(str(tmp_path / "grey.hdr"), np.full((32, 64, 3), 0.5, dtype=np.float32))
-    maps = Backgrounds(renderer.ctx, renderer.resources.fullscreen, tmp_path)
+    maps = EnvironmentMaps(renderer.ctx, tmp_path)
     try:
-        environment = (maps.texture("grey.hdr"), maps.irradiance("grey.hdr"))
+        uploaded = maps.get("grey.hdr")
+        environment = (uploaded.texture, uploaded.irradiance)
         n = as_f32(np.concatenate([np.eye(3), -np.eye(3)]))
         gl = renderer.probes.lobe(material(0.0, 0.0), "irradiance", (n,), environment)[0]
     finally:

@@ -170,7 +170,7 @@ def test_environment_picker_backdrop_and_blur(page):
     mesh drop shows the same choice."""
     open_page(page)
     options = page.eval_on_selector_all("#in-environment option", "os => os.map(o => o.text)")
-    assert options == ["preset's", "studio", "neutral", "sky", "file…"], options
+    assert options == ["preset's", "studio", "neutral", "sky", "none", "file…"], options
     assert page.locator("#in-environment-file").is_hidden()
     plain = shown_bytes(page)
     page.select_option("#in-environment", "neutral")

@@ -43,9 +43,12 @@ class Shot:
     environment: str | None = None
 
     def request(self, size: int, quality: Quality, transparent: bool = False) -> RenderRequest:
+        # The mask leaves the backdrop out: a preset that shows its environment behind the
+        # object would otherwise cover the whole frame.
         return RenderRequest(preset=self.preset, mesh=None if self.mesh is None else str(self.mesh),
                              environment=self.environment, width=size, height=size,
-                             quality=quality, transparent=transparent or None)
+                             quality=quality, transparent=transparent or None,
+                             environment_background=False if transparent else None)
 
 
 def preset_shots(presets: Sequence[str]) -> list[Shot]:

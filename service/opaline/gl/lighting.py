@@ -3,7 +3,8 @@ environment turned into K directional lights (``scene.environments``).
 
 K is a quality knob like samples and wavelengths: the job's
 ``environment_lights`` if it sets one, else its tier's (``Job.environment_count``).
-An environment replaces the preset's lights; the preset's ambient term stays.
+An environment replaces the preset's lights and its ambient term (the lights carry all of
+the map, its diffuse part too).
 """
 
 from __future__ import annotations

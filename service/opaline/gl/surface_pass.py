@@ -119,7 +119,8 @@ class SurfacePass:
             "u_view_proj": where.view_proj.astype("f4"),
             "u_eye": where.eye,
             **lights,
-            "u_ambient": tuple(preset.ambient),
+            # An environment is the whole light: its lights carry the map's diffuse part too.
+            "u_ambient": (0.0, 0.0, 0.0) if job.environment else tuple(preset.ambient),
             "u_aa_scale": plan.samples.aa_scale,
             "u_exposure": job.exposure,
             **heightfield.uniforms(preset),

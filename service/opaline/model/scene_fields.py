@@ -38,14 +38,16 @@ class SceneFields(BaseModel):
                           "'auto' (default): 'uv' where the mesh has UVs, else 'concentric'.")
     tangent_axis: Finite3 | None = Field(
         None, description="Axis of the concentric field, or direction of the projected one "
-                          "(default 0,1,0).")
+                          "(default 0,1,0; an axis of length under 1e-9, which has no "
+                          "direction, is the default).")
 
     @field_validator("tangent_axis")
     @classmethod
     def _direction(cls, axis: Finite3 | None) -> Finite3 | None:
-        # Refused here, a 422 naming the field, not when a worker builds the field.
+        # Every schema-valid value is accepted (the schema cannot state a length): one with
+        # no direction means the default, decided here, before a worker builds the field.
         if axis is not None and sum(c * c for c in axis) < 1e-18:
-            raise ValueError("must be a non-zero direction")
+            return None
         return axis
     camera_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Camera azimuth in degrees around the target's up axis "

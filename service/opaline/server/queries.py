@@ -67,7 +67,8 @@ class MdfQuery(MaterialFields):
         0, json_schema_extra=wavelengths_schema,
         description="0 = the paper's RGB rotations, else 4 … 128 wavelengths (CIE 1931).")
 
-    _albedo = field_validator("albedo", mode="before")(_comma_list)
+    _tuples = field_validator(*tuple_fields(MaterialFields) | {"albedo"},
+                              mode="before")(_comma_list)
     _wavelengths = field_validator("wavelengths")(wavelengths_ok)
 
 
