@@ -44,6 +44,7 @@ void main() {
 #endif
 
 #ifdef FRAGMENT_SHADER
+#include "material_params.glsl"
 #include "lib/reflectance.glsl"
 #ifdef ENVIRONMENT_MAP
 #include "lib/environment_light.glsl"
@@ -149,6 +150,7 @@ void main() {
     }
 #endif
     mat3 frame = shading_frame(n, t);
+    Material mat = material_params();
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP) && defined(OBJECT_PROJECTION)
     float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
                         w.x * texture(u_thickness_map, triplanar_uv_x(q)).r
@@ -166,9 +168,9 @@ void main() {
 #ifdef ENVIRONMENT_MAP
     // The map is the whole light (with its bright features below): its irradiance
     // replaces the preset's ambient term. First: it sets the per-pixel film colour.
-    radiance = environment_specular(frame, v, film_nm);
+    radiance = environment_specular(mat, frame, v, film_nm);
 #ifdef DIFFUSE
-    radiance += environment_irradiance(vec3(frame[2])) * u_kd * u_albedo / PI;
+    radiance += environment_irradiance(vec3(frame[2])) * mat.kd * mat.albedo / PI;
 #endif
 #endif
 #ifdef LIGHT_COUNT
@@ -178,11 +180,11 @@ void main() {
         float dist2 = max(dot(to_light, to_light), 1e-8);
         vec3 l = to_light * inversesqrt(dist2);
         float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
-        radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v, film_nm);
+        radiance += u_light_irradiance[i] * falloff * reflected_radiance(mat, frame, l, v, film_nm);
     }
 #endif
 #if defined(DIFFUSE) && !defined(ENVIRONMENT_MAP)
-    radiance += u_ambient * u_kd * u_albedo;
+    radiance += u_ambient * mat.kd * mat.albedo;
 #endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
     // A free, lossless film transmits what it does not reflect: the backdrop seen

@@ -78,29 +78,29 @@ vec3 env_sequence(int k, vec3 shift) {
 }
 
 // A half vector from the lobe and the density of the whole mixture there.
-vec4 env_sample_half(vec3 u) {
+vec4 env_sample_half(Material mat, vec3 u) {
 #if defined(MDF_MULTIPEAK) || defined(IRIDESCENCE_GRATING)
     // A grating's orders lie away from the mirror direction: only its brute-force
     // reference reads the map, through the envelope as the multi-peak lobe does.
     return sample_projected_disc(u.xy);
 #elif defined(IRIDESCENCE_THIN_FILM)
-    return sample_ashikhmin(u.xy, u_ex, u_ey);
+    return sample_ashikhmin(u.xy, mat.ex, mat.ey);
 #else
     // Rotation colour: one of the three channels' lobes (each is eq. 1's lobe turned by
     // -θc), chosen at random, weighted by the mixture's density (one-sample MIS).
     int c = int(min(u.z * 3.0, 2.0));
-    vec4 s = sample_ashikhmin(u.xy, u_ex, u_ey);
+    vec4 s = sample_ashikhmin(u.xy, mat.ex, mat.ey);
     vec2 cs = u_env_lobe_rotation[c];
     vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
     float pdf = 0.0;
     for (int i = 0; i < 3; ++i) {
-        pdf += mdf_ashikhmin(rotate_half(h.xy, u_env_lobe_rotation[i]), h.z, u_ex, u_ey);
+        pdf += mdf_ashikhmin(rotate_half(h.xy, u_env_lobe_rotation[i]), h.z, mat.ex, mat.ey);
     }
     return vec4(h, pdf / 3.0);
 #endif
 }
 
-vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
+vec3 environment_specular(Material mat, realmat3 frame, vec3 v, float film_nm) {
     vec3 vl = vec3(transpose(frame) * real3(v));
 #ifdef FILM_PER_PIXEL
     // At the mirror direction's v·h = n·v: over a glossy lobe v·h hardly moves, and the
@@ -110,7 +110,7 @@ vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
     vec3 shift = env_pixel_shift();
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {
-        vec4 s = env_sample_half(env_sequence(u_env_pass * ENV_SAMPLES + i, shift));
+        vec4 s = env_sample_half(mat, env_sequence(u_env_pass * ENV_SAMPLES + i, shift));
         float vh = dot(vl, s.xyz);
         vec3 ll = 2.0 * vh * s.xyz - vl;
         if (vh <= 0.0 || ll.z <= 0.0 || s.w <= 0.0) {
@@ -119,7 +119,7 @@ vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
         // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
         vec3 l = vec3(frame * real3(ll));
-        vec3 f = specular(frame, l, v, film_nm) * ll.z;
+        vec3 f = specular(mat, frame, l, v, film_nm) * ll.z;
         vec3 m = env_to_map(l);
         sum += env_lookup(m, env_lod(m, pdf_l)) * (f / pdf_l);
     }

@@ -47,61 +47,61 @@ float grating_efficiency(int m, float lam, float kn) {
 }
 
 // One order's lobe without η: k = (l+v) in the frame with its b component kb.
-float order_lobe(vec3 k, vec3 vl, float cos_max) {
+float order_lobe(Material mat, vec3 k, vec3 vl, float cos_max) {
     float k2 = max(dot(k, k), EPS_K2);
     float k_len = sqrt(k2);
     vec3 h = k / k_len;
     float vh = dot(vl, h);
 #ifdef FRESNEL
-    float f = fresnel_schlick(vh, u_f0);
+    float f = fresnel_schlick(vh, mat.f0);
 #else
     float f = 1.0;
 #endif
-    return f * mdf_ashikhmin(h.xy, h.z, u_ex, u_ey) * max(vh, 0.0) / (k2 * cos_max);
+    return f * mdf_ashikhmin(h.xy, h.z, mat.ex, mat.ey) * max(vh, 0.0) / (k2 * cos_max);
 }
 
 #if WAVELENGTHS > 0
 uniform float u_wavelength_nm[WAVELENGTHS];
 
 // Orders ±m at one wavelength: J_{-m}² = J_m², so one series serves both signs.
-float order_pair(int m, float lam, float step_b, vec3 k, vec3 vl, float cos_max) {
+float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, float cos_max) {
     float shift = float(m) * step_b;
-    float lobes = order_lobe(vec3(k.x, k.y - shift, k.z), vl, cos_max)
-                + order_lobe(vec3(k.x, k.y + shift, k.z), vl, cos_max);
+    float lobes = order_lobe(mat, vec3(k.x, k.y - shift, k.z), vl, cos_max)
+                + order_lobe(mat, vec3(k.x, k.y + shift, k.z), vl, cos_max);
     return grating_efficiency(m, lam, k.z) * lobes;
 }
 
 // Σ_i w_i Σ_{|m| ≤ M} η_m(λ_i)·lobe_m(λ_i). The orders are written out, not looped:
 // with m a literal the Bessel series' divisors are constants (a loop over m this
 // large is not unrolled by Mesa, and its divisions cost a quarter of the draw).
-vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
-    float zero = order_lobe(k, vl, cos_max);  // the mirror order: the same at every λ
+    float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
     for (int i = 0; i < WAVELENGTHS; ++i) {
         float lam = u_wavelength_nm[i];
         float step_b = lam / u_grating_pitch_nm;
         float s = grating_efficiency(0, lam, k.z) * zero;
-        s += order_pair(1, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 1, lam, step_b, k, vl, cos_max);
 #if GRATING_ORDERS >= 2
-        s += order_pair(2, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 2, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 3
-        s += order_pair(3, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 3, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 4
-        s += order_pair(4, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 4, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 5
-        s += order_pair(5, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 5, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 6
-        s += order_pair(6, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 6, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 7
-        s += order_pair(7, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 7, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 8
-        s += order_pair(8, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 8, lam, step_b, k, vl, cos_max);
 #endif
         sum += u_spectral_weight[i] * s;
     }
@@ -124,11 +124,11 @@ vec3 visible_density(float lam) {
     return mix(u_visible_density[i], u_visible_density[i + 1], x - float(i));
 }
 
-vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 k0 = vec3(k.x, 0.0, k.z);
-    float base = order_lobe(k0, vl, cos_max);
+    float base = order_lobe(mat, k0, vl, cos_max);
     float k0_len = sqrt(max(dot(k0, k0), EPS_K2));
-    float width = sqrt(TWO_PI / max(u_ey, 1.0));
+    float width = sqrt(TWO_PI / max(mat.ey, 1.0));
     vec3 sum = vec3(0.0);
     for (int m = 1; m <= GRATING_ORDERS; ++m) {
         float spread = u_grating_pitch_nm / float(m) * k0_len * width;
@@ -143,7 +143,7 @@ vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
             sum += density * (spread * grating_efficiency(m, lam, k.z) * base);
         }
     }
-    float zero = order_lobe(k, vl, cos_max);
+    float zero = order_lobe(mat, k, vl, cos_max);
     vec3 eta0 = vec3(grating_efficiency(0, u_channel_nm.r, k.z),
                      grating_efficiency(0, u_channel_nm.g, k.z),
                      grating_efficiency(0, u_channel_nm.b, k.z));
@@ -151,12 +151,12 @@ vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
 }
 #endif
 
-vec3 grating_specular(realmat3 frame, vec3 l, vec3 v) {
+vec3 grating_specular(Material mat, realmat3 frame, vec3 l, vec3 v) {
     vec3 k = vec3(transpose(frame) * (real3(l) + real3(v)));  // (·t, ·b, ·n)
     vec3 vl = vec3(transpose(frame) * real3(v));
     float nl = float(dot(frame[2], real3(l)));
     float cos_max = max(max(nl, vl.z), EPS_DENOM);
-    return grating_color(k, vl, cos_max);
+    return grating_color(mat, k, vl, cos_max);
 }
 
 #endif

@@ -1,0 +1,67 @@
+// The material's parameters as gl/material_program.py sets them, by name, and the
+// Material the library takes (lib/material.glsl), filled from them. Included by the
+// programs that shade the material, and by the GLSL export (gl/export_glsl.py),
+// which turns each of these declarations into a constant.
+#include "lib/common.glsl"
+#if WAVELENGTHS > 0
+uniform real2 u_spectral_rotation[WAVELENGTHS];
+uniform vec3 u_spectral_weight[WAVELENGTHS];
+#endif
+#include "lib/material.glsl"
+
+#if defined(MDF_ASHIKHMIN)
+uniform float u_ex;
+uniform float u_ey;
+#else
+uniform real u_mu_f;
+uniform real u_alpha;
+uniform real u_beta;
+#ifdef AA_ANALYTIC
+uniform float u_aa_scale;
+#endif
+#endif
+uniform float u_ks;
+#ifdef DIFFUSE
+uniform float u_kd;
+uniform vec3 u_albedo;
+#endif
+#ifdef FRESNEL
+uniform float u_f0;
+#endif
+#if WAVELENGTHS == 0
+uniform real2 u_rotation[3];
+#endif
+
+Material material_params() {
+    Material mat;
+#if defined(MDF_ASHIKHMIN)
+    mat.ex = u_ex;
+    mat.ey = u_ey;
+#else
+    mat.mu_f = u_mu_f;
+    mat.alpha = u_alpha;
+    mat.beta = u_beta;
+#ifdef AA_ANALYTIC
+    mat.aa_scale = u_aa_scale;
+#else
+    mat.aa_scale = 1.0;
+#endif
+#endif
+    mat.ks = u_ks;
+#ifdef DIFFUSE
+    mat.kd = u_kd;
+    mat.albedo = u_albedo;
+#else
+    mat.kd = 0.0;  // not read: no diffuse term is compiled in
+    mat.albedo = vec3(0.0);
+#endif
+#ifdef FRESNEL
+    mat.f0 = u_f0;
+#else
+    mat.f0 = 0.0;  // not read: Fresnel is off
+#endif
+#if WAVELENGTHS == 0
+    mat.rotation = u_rotation;
+#endif
+    return mat;
+}
