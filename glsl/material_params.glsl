@@ -7,6 +7,13 @@
 uniform real2 u_spectral_rotation[WAVELENGTHS];
 uniform vec3 u_spectral_weight[WAVELENGTHS];
 #endif
+#ifdef IRIDESCENCE_GRATING
+#if WAVELENGTHS > 0
+uniform float u_wavelength_nm[WAVELENGTHS];
+#else
+uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
+#endif
+#endif
 #include "lib/material.glsl"
 
 #if defined(MDF_ASHIKHMIN)
@@ -30,6 +37,13 @@ uniform float u_f0;
 #endif
 #if WAVELENGTHS == 0
 uniform real2 u_rotation[3];
+#endif
+#ifdef IRIDESCENCE_GRATING
+uniform float u_grating_pitch_nm;
+uniform float u_grating_depth_nm;
+#if WAVELENGTHS == 0
+uniform vec3 u_channel_nm;
+#endif
 #endif
 
 Material material_params() {
@@ -62,6 +76,13 @@ Material material_params() {
 #endif
 #if WAVELENGTHS == 0
     mat.rotation = u_rotation;
+#endif
+#ifdef IRIDESCENCE_GRATING
+    mat.grating.pitch_nm = u_grating_pitch_nm;
+    mat.grating.depth_nm = u_grating_depth_nm;
+#if WAVELENGTHS == 0
+    mat.grating.channel_nm = u_channel_nm;
+#endif
 #endif
     return mat;
 }

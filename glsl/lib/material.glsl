@@ -7,6 +7,7 @@
 // a copy per call):
 //   real2 u_spectral_rotation[WAVELENGTHS];  (cos θ(λ), sin θ(λ))
 //   vec3 u_spectral_weight[WAVELENGTHS];     its weight into linear sRGB
+// The iridescence sources' own tables are named at the top of their files.
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL
 #include "lib/common.glsl"
@@ -21,6 +22,16 @@
 #endif
 #ifdef FRESNEL
 #include "lib/fresnel.glsl"
+#endif
+
+#ifdef IRIDESCENCE_GRATING
+struct Grating {  // lib/grating.glsl
+    float pitch_nm;
+    float depth_nm;
+#if WAVELENGTHS == 0
+    vec3 channel_nm;  // where η_0 is taken per channel
+#endif
+};
 #endif
 
 struct Material {
@@ -39,6 +50,9 @@ struct Material {
     float f0;
 #if WAVELENGTHS == 0
     real2 rotation[3];  // (cos θ, sin θ) for R, G, B: θ = 0, theta1, theta2
+#endif
+#ifdef IRIDESCENCE_GRATING
+    Grating grating;
 #endif
 };
 
