@@ -7,12 +7,21 @@
 uniform real2 u_spectral_rotation[WAVELENGTHS];
 uniform vec3 u_spectral_weight[WAVELENGTHS];
 #endif
-#ifdef IRIDESCENCE_GRATING
-#if WAVELENGTHS > 0
+#if WAVELENGTHS > 0 && (defined(IRIDESCENCE_THIN_FILM) || defined(IRIDESCENCE_GRATING))
 uniform float u_wavelength_nm[WAVELENGTHS];
-#else
-uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
 #endif
+#if WAVELENGTHS == 0 && defined(IRIDESCENCE_THIN_FILM)
+uniform vec3 u_film_sens_weight[3];
+uniform vec3 u_film_sens_centre[3];
+uniform vec3 u_film_sens_sigma[3];
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR) && WAVELENGTHS > 0
+uniform vec2 u_substrate_nk[WAVELENGTHS];
+#elif defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR)
+uniform vec2 u_substrate_nk[3];
+#endif
+#if WAVELENGTHS == 0 && defined(IRIDESCENCE_GRATING)
+uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
 #endif
 #include "lib/material.glsl"
 
@@ -37,6 +46,12 @@ uniform float u_f0;
 #endif
 #if WAVELENGTHS == 0
 uniform real2 u_rotation[3];
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+uniform float u_film_ior;
+uniform float u_substrate_ior;
+uniform float u_film_thickness_min;
+uniform float u_film_thickness_max;
 #endif
 #ifdef IRIDESCENCE_GRATING
 uniform float u_grating_pitch_nm;
@@ -76,6 +91,12 @@ Material material_params() {
 #endif
 #if WAVELENGTHS == 0
     mat.rotation = u_rotation;
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+    mat.film.ior = u_film_ior;
+    mat.film.substrate_ior = u_substrate_ior;
+    mat.film.thickness_min = u_film_thickness_min;
+    mat.film.thickness_max = u_film_thickness_max;
 #endif
 #ifdef IRIDESCENCE_GRATING
     mat.grating.pitch_nm = u_grating_pitch_nm;

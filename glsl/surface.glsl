@@ -152,12 +152,12 @@ void main() {
     mat3 frame = shading_frame(n, t);
     Material mat = material_params();
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP) && defined(OBJECT_PROJECTION)
-    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+    float film_nm = mix(mat.film.thickness_min, mat.film.thickness_max,
                         w.x * texture(u_thickness_map, triplanar_uv_x(q)).r
                         + w.y * texture(u_thickness_map, triplanar_uv_y(q)).r
                         + w.z * texture(u_thickness_map, triplanar_uv_z(q)).r);
 #elif defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
-    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+    float film_nm = mix(mat.film.thickness_min, mat.film.thickness_max,
                         texture(u_thickness_map, v_uv).r);
 #else
     float film_nm = -1.0;  // the material's maximum (thin film), else not read
@@ -190,7 +190,8 @@ void main() {
     // A free, lossless film transmits what it does not reflect: the backdrop seen
     // through both walls, each met at the view's angle to the surface (the back
     // wall's own thickness is not known: this one's is used).
-    vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm(film_nm));
+    vec3 through = vec3(1.0) - film_rgb(mat.film, abs(float(dot(frame[2], v))),
+                                     film_thickness_nm(mat.film, film_nm));
 #ifdef ENV_BACKDROP
     // The environment behind, straight through the film, where it is the background.
     vec3 behind = env_lookup(env_to_map(-v), 0.0);

@@ -24,6 +24,14 @@
 #include "lib/fresnel.glsl"
 #endif
 
+#ifdef IRIDESCENCE_THIN_FILM
+struct Film {  // lib/thin_film.glsl
+    float ior;
+    float substrate_ior;  // not read over a conductor: its n + ik is a table
+    float thickness_min;  // nm: a thickness map's 0
+    float thickness_max;  // nm: its 1, and the thickness without a map
+};
+#endif
 #ifdef IRIDESCENCE_GRATING
 struct Grating {  // lib/grating.glsl
     float pitch_nm;
@@ -50,6 +58,9 @@ struct Material {
     float f0;
 #if WAVELENGTHS == 0
     real2 rotation[3];  // (cos θ, sin θ) for R, G, B: θ = 0, theta1, theta2
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+    Film film;
 #endif
 #ifdef IRIDESCENCE_GRATING
     Grating grating;

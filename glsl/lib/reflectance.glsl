@@ -16,12 +16,12 @@
 #ifdef FILM_PER_PIXEL
 // Environment light evaluates the film once per pixel (lib/environment_light.glsl).
 vec3 g_film_colour;
-vec3 film_colour(float vh, float film_nm) {
+vec3 film_colour(Material mat, float vh, float film_nm) {
     return g_film_colour;
 }
 #else
-vec3 film_colour(float vh, float film_nm) {
-    return film_rgb(vh, film_thickness_nm(film_nm));
+vec3 film_colour(Material mat, float vh, float film_nm) {
+    return film_rgb(mat.film, vh, film_thickness_nm(mat.film, film_nm));
 }
 #endif
 #endif
@@ -43,7 +43,7 @@ vec3 specular(Material mat, realmat3 frame, vec3 l, vec3 v, float film_nm) {
     float vh = float(dot(real3(v), h));
 #ifdef IRIDESCENCE_THIN_FILM
     // The unrotated lobe, coloured by the film instead of by rotation (Fresnel off).
-    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), mat.ex, mat.ey) * film_colour(vh, film_nm);
+    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), mat.ex, mat.ey) * film_colour(mat, vh, film_nm);
 #else
     vec3 d = mdf_color(mat, hl.xy, float(hl.z));
 #endif
