@@ -2,6 +2,8 @@
 // Material the library takes (lib/material.glsl), filled from them. Included by the
 // programs that shade the material, and by the GLSL export (gl/export_glsl.py),
 // which turns each of these declarations into a constant.
+#ifndef MATERIAL_PARAMS_GLSL
+#define MATERIAL_PARAMS_GLSL
 #include "lib/common.glsl"
 #if WAVELENGTHS > 0
 uniform real2 u_spectral_rotation[WAVELENGTHS];
@@ -107,3 +109,5 @@ Material material_params() {
 #endif
     return mat;
 }
+
+#endif

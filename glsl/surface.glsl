@@ -47,7 +47,7 @@ void main() {
 #include "material_params.glsl"
 #include "lib/reflectance.glsl"
 #ifdef ENVIRONMENT_MAP
-#include "lib/environment_light.glsl"
+#include "environment_params.glsl"
 #endif
 
 in vec3 v_world;
@@ -151,6 +151,9 @@ void main() {
 #endif
     mat3 frame = shading_frame(n, t);
     Material mat = material_params();
+#ifdef ENVIRONMENT_MAP
+    Environment env = environment_params();
+#endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP) && defined(OBJECT_PROJECTION)
     float film_nm = mix(mat.film.thickness_min, mat.film.thickness_max,
                         w.x * texture(u_thickness_map, triplanar_uv_x(q)).r
@@ -168,9 +171,9 @@ void main() {
 #ifdef ENVIRONMENT_MAP
     // The map is the whole light (with its bright features below): its irradiance
     // replaces the preset's ambient term. First: it sets the per-pixel film colour.
-    radiance = environment_specular(mat, frame, v, film_nm);
+    radiance = environment_specular(mat, env, frame, v, film_nm);
 #ifdef DIFFUSE
-    radiance += environment_irradiance(vec3(frame[2])) * mat.kd * mat.albedo / PI;
+    radiance += environment_irradiance(env, vec3(frame[2])) * mat.kd * mat.albedo / PI;
 #endif
 #endif
 #ifdef LIGHT_COUNT
@@ -194,7 +197,7 @@ void main() {
                                      film_thickness_nm(mat.film, film_nm));
 #ifdef ENV_BACKDROP
     // The environment behind, straight through the film, where it is the background.
-    vec3 behind = env_lookup(env_to_map(-v), 0.0);
+    vec3 behind = env_lookup(env, env_to_map(env, -v), 0.0);
 #else
     vec3 behind = u_backdrop;
 #endif
