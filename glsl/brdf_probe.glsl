@@ -5,6 +5,7 @@
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
+#include "material_params.glsl"
 #include "lib/reflectance.glsl"
 
 uniform sampler2D u_normal;
@@ -19,6 +20,6 @@ void main() {
     vec3 t = texelFetch(u_tangent, px, 0).xyz;
     vec3 l = texelFetch(u_light, px, 0).xyz;
     vec3 v = texelFetch(u_view, px, 0).xyz;
-    frag_color = vec4(reflected_radiance(shading_frame(real3(n), real3(t)), l, v, -1.0), 1.0);
+    frag_color = vec4(reflected_radiance(material_params(), shading_frame(real3(n), real3(t)), l, v, -1.0), 1.0);
 }
 #endif

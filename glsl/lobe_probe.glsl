@@ -9,7 +9,8 @@
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
-#include "lib/environment_light.glsl"
+#include "material_params.glsl"
+#include "environment_params.glsl"
 
 uniform sampler2D u_case_a;
 uniform sampler2D u_case_b;
@@ -22,20 +23,22 @@ void main() {
     vec3 a = texelFetch(u_case_a, px, 0).xyz;
     vec3 b = texelFetch(u_case_b, px, 0).xyz;
     vec3 c = texelFetch(u_case_c, px, 0).xyz;
+    Material mat = material_params();
+    Environment env = environment_params();
     frag_color = vec4(0.0);
 #ifdef MDF_ASHIKHMIN
     if (u_mode == 0) {
-        frag_color = sample_ashikhmin(a.xy, u_ex, u_ey);
+        frag_color = sample_ashikhmin(a.xy, mat.ex, mat.ey);
     }
 #endif
     if (u_mode == 1) {
         frag_color = sample_projected_disc(a.xy);
     } else if (u_mode == 2) {
-        frag_color = env_sample_half(a);
+        frag_color = env_sample_half(mat, env, a);
     } else if (u_mode == 3) {
-        frag_color = vec4(environment_irradiance(a), 1.0);
+        frag_color = vec4(environment_irradiance(env, a), 1.0);
     } else if (u_mode == 4) {
-        frag_color = vec4(environment_specular(shading_frame(a, b), c, -1.0), 1.0);
+        frag_color = vec4(environment_specular(mat, env, shading_frame(a, b), c, -1.0), 1.0);
     } else if (u_mode == 5) {
         frag_color = vec4(env_sequence(int(a.x), b), 1.0);
     }

@@ -5,7 +5,7 @@
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
-#include "lib/material.glsl"
+#include "material_params.glsl"
 
 uniform int u_size;
 out vec4 frag_color;
@@ -18,6 +18,6 @@ void main() {
         return;
     }
     float hz = float(sqrt(1.0 - s2));
-    frag_color = vec4(mdf_color(h, hz), 1.0);
+    frag_color = vec4(mdf_color(material_params(), h, hz), 1.0);
 }
 #endif

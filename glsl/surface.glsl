@@ -44,9 +44,10 @@ void main() {
 #endif
 
 #ifdef FRAGMENT_SHADER
+#include "material_params.glsl"
 #include "lib/reflectance.glsl"
 #ifdef ENVIRONMENT_MAP
-#include "lib/environment_light.glsl"
+#include "environment_params.glsl"
 #endif
 
 in vec3 v_world;
@@ -149,13 +150,17 @@ void main() {
     }
 #endif
     mat3 frame = shading_frame(n, t);
+    Material mat = material_params();
+#ifdef ENVIRONMENT_MAP
+    Environment env = environment_params();
+#endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP) && defined(OBJECT_PROJECTION)
-    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+    float film_nm = mix(mat.film.thickness_min, mat.film.thickness_max,
                         w.x * texture(u_thickness_map, triplanar_uv_x(q)).r
                         + w.y * texture(u_thickness_map, triplanar_uv_y(q)).r
                         + w.z * texture(u_thickness_map, triplanar_uv_z(q)).r);
 #elif defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
-    float film_nm = mix(u_film_thickness_min, u_film_thickness_max,
+    float film_nm = mix(mat.film.thickness_min, mat.film.thickness_max,
                         texture(u_thickness_map, v_uv).r);
 #else
     float film_nm = -1.0;  // the material's maximum (thin film), else not read
@@ -166,9 +171,9 @@ void main() {
 #ifdef ENVIRONMENT_MAP
     // The map is the whole light (with its bright features below): its irradiance
     // replaces the preset's ambient term. First: it sets the per-pixel film colour.
-    radiance = environment_specular(frame, v, film_nm);
+    radiance = environment_specular(mat, env, frame, v, film_nm);
 #ifdef DIFFUSE
-    radiance += environment_irradiance(vec3(frame[2])) * u_kd * u_albedo / PI;
+    radiance += environment_irradiance(env, vec3(frame[2])) * mat.kd * mat.albedo / PI;
 #endif
 #endif
 #ifdef LIGHT_COUNT
@@ -178,20 +183,21 @@ void main() {
         float dist2 = max(dot(to_light, to_light), 1e-8);
         vec3 l = to_light * inversesqrt(dist2);
         float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
-        radiance += u_light_irradiance[i] * falloff * reflected_radiance(frame, l, v, film_nm);
+        radiance += u_light_irradiance[i] * falloff * reflected_radiance(mat, frame, l, v, film_nm);
     }
 #endif
 #if defined(DIFFUSE) && !defined(ENVIRONMENT_MAP)
-    radiance += u_ambient * u_kd * u_albedo;
+    radiance += u_ambient * mat.kd * mat.albedo;
 #endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(TRANSMISSION)
     // A free, lossless film transmits what it does not reflect: the backdrop seen
     // through both walls, each met at the view's angle to the surface (the back
     // wall's own thickness is not known: this one's is used).
-    vec3 through = vec3(1.0) - film_rgb(abs(float(dot(frame[2], v))), film_thickness_nm(film_nm));
+    vec3 through = vec3(1.0) - film_rgb(mat.film, abs(float(dot(frame[2], v))),
+                                     film_thickness_nm(mat.film, film_nm));
 #ifdef ENV_BACKDROP
     // The environment behind, straight through the film, where it is the background.
-    vec3 behind = env_lookup(env_to_map(-v), 0.0);
+    vec3 behind = env_lookup(env, env_to_map(env, -v), 0.0);
 #else
     vec3 behind = u_backdrop;
 #endif

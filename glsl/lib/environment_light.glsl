@@ -9,48 +9,53 @@
 // Diffuse: the map's irradiance in nine spherical harmonics (Ramamoorthi & Hanrahan
 // 2001), exact for a Lambertian term to within ~3 % of the map's irradiance.
 // Float64 twins: opaline/model/lobe_sampling.py, opaline/model/irradiance.py.
+// The environment comes in as an Environment, filled once per fragment by the program
+// (glsl/environment_params.glsl). Contract: the program declares, before this file,
+//   sampler2D u_env_map;  linear radiance, equirectangular, v = 1 at the zenith
+// (a sampler cannot be a member of a struct variable).
 #ifndef ENVIRONMENT_LIGHT_GLSL
 #define ENVIRONMENT_LIGHT_GLSL
 #include "lib/reflectance.glsl"
 #include "lib/lobe_sampling.glsl"
 
-uniform sampler2D u_env_map;  // linear radiance, equirectangular, v = 1 at the zenith
-uniform float u_env_rotation;  // radians the environment is turned about +y
-uniform float u_env_intensity;
-uniform vec2 u_env_size;  // level 0, texels
-uniform float u_env_max_lod;
-uniform int u_env_pass;  // this pass's index: passes continue one sequence
-uniform float u_env_total;  // the pixel's samples over all passes
-uniform vec2 u_env_lobe_rotation[3];  // (cos, sin) of 0, theta1, theta2: the lobes sampled
-uniform vec3 u_env_sh[9];  // irradiance coefficients, Â_l and Y_lm's constants folded in
+struct Environment {
+    float rotation;  // radians the environment is turned about +y
+    float intensity;
+    vec2 size;  // the map's level 0, texels
+    float max_lod;
+    int pass;  // this pass's index: passes continue one sequence
+    float total;  // the pixel's samples over all passes
+    vec2 lobe_rotation[3];  // (cos, sin) of 0, theta1, theta2: the lobes sampled
+    vec3 sh[9];  // irradiance coefficients, Â_l and Y_lm's constants folded in
+};
 
 // Into the map's own frame (the environment turns, the object stays).
-vec3 env_to_map(vec3 d) {
-    float c = cos(u_env_rotation);
-    float s = sin(u_env_rotation);
+vec3 env_to_map(Environment env, vec3 d) {
+    float c = cos(env.rotation);
+    float s = sin(env.rotation);
     return vec3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
 }
 
-vec3 env_lookup(vec3 m, float lod) {
+vec3 env_lookup(Environment env, vec3 m, float lod) {
     float azimuth = atan(m.z, m.x);
     float elevation = asin(clamp(m.y, -1.0, 1.0));
     vec2 uv = vec2(fract(azimuth / TWO_PI), 0.5 + elevation / PI);
-    return textureLod(u_env_map, uv, lod).rgb * u_env_intensity;
+    return textureLod(u_env_map, uv, lod).rgb * env.intensity;
 }
 
 // The level whose texel spans 1/(N·pdf): a level-0 texel spans (2π/W)(π/H)·cos(elevation).
-float env_lod(vec3 m, float pdf_l) {
+float env_lod(Environment env, vec3 m, float pdf_l) {
 #ifdef ENV_BRUTE
     return 0.0;
 #else
-    float texel = TWO_PI * PI / (u_env_size.x * u_env_size.y)
-                  * max(sqrt(max(1.0 - m.y * m.y, 0.0)), 0.5 / u_env_size.y);
-    float share = 1.0 / max(u_env_total * pdf_l, 1e-30);
+    float texel = TWO_PI * PI / (env.size.x * env.size.y)
+                  * max(sqrt(max(1.0 - m.y * m.y, 0.0)), 0.5 / env.size.y);
+    float share = 1.0 / max(env.total * pdf_l, 1e-30);
     // Colbert & Křivánek add 1 (a sample's footprint is wider than its share) for ~40
     // samples; at the tiers' 2-64 a trilinear read of that level is wider than the lobe
     // itself. Measured against the brute-force reference (bench/environment_accuracy.py),
     // FLIP is least at -2 for every tier, map and lobe tried (docs/accuracy.md).
-    return clamp(0.5 * log2(share / texel) - 2.0, 0.0, u_env_max_lod);
+    return clamp(0.5 * log2(share / texel) - 2.0, 0.0, env.max_lod);
 #endif
 }
 
@@ -78,46 +83,46 @@ vec3 env_sequence(int k, vec3 shift) {
 }
 
 // A half vector from the lobe and the density of the whole mixture there.
-vec4 env_sample_half(vec3 u) {
+vec4 env_sample_half(Material mat, Environment env, vec3 u) {
 #if defined(MDF_MULTIPEAK) || defined(IRIDESCENCE_GRATING)
     // A grating's orders lie away from the mirror direction: only its brute-force
     // reference reads the map, through the envelope as the multi-peak lobe does.
     return sample_projected_disc(u.xy);
 #elif defined(IRIDESCENCE_THIN_FILM)
-    return sample_ashikhmin(u.xy, u_ex, u_ey);
+    return sample_ashikhmin(u.xy, mat.ex, mat.ey);
 #else
     // Rotation colour: one of the three channels' lobes (each is eq. 1's lobe turned by
     // -θc), chosen at random, weighted by the mixture's density (one-sample MIS).
     int c = int(min(u.z * 3.0, 2.0));
-    vec4 s = sample_ashikhmin(u.xy, u_ex, u_ey);
-    vec2 cs = u_env_lobe_rotation[c];
+    vec4 s = sample_ashikhmin(u.xy, mat.ex, mat.ey);
+    vec2 cs = env.lobe_rotation[c];
     vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
     float pdf = 0.0;
     for (int i = 0; i < 3; ++i) {
-        pdf += mdf_ashikhmin(rotate_half(h.xy, u_env_lobe_rotation[i]), h.z, u_ex, u_ey);
+        pdf += mdf_ashikhmin(rotate_half(h.xy, env.lobe_rotation[i]), h.z, mat.ex, mat.ey);
     }
     return vec4(h, pdf / 3.0);
 #endif
 }
 
-vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
+vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
     vec3 vl = vec3(transpose(frame) * real3(v));
 #ifdef FILM_PER_PIXEL
     // At the mirror direction's v·h = n·v: over a glossy lobe v·h hardly moves, and the
     // film is most of a sample's cost (the Sample Viewer's split sum does the same).
-    g_film_colour = film_rgb(clamp(vl.z, 0.0, 1.0), film_thickness_nm(film_nm));
+    g_film_colour = film_rgb(mat.film, clamp(vl.z, 0.0, 1.0), film_thickness_nm(mat.film, film_nm));
 #endif
     vec3 shift = env_pixel_shift();
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {
-        vec3 u = env_sequence(u_env_pass * ENV_SAMPLES + i, shift);
+        vec3 u = env_sequence(env.pass * ENV_SAMPLES + i, shift);
 #if ENV_SAMPLES % 3 == 0
         // Each of the rotation source's three lobes gets exactly a third of a pass's
         // samples (multi-sample MIS, balance heuristic: the mixture's density is still
         // the weight): no pass leaves a channel's lobe with one sample or none.
         u.z = (float(i % 3) + 0.5) / 3.0;
 #endif
-        vec4 s = env_sample_half(u);
+        vec4 s = env_sample_half(mat, env, u);
         float vh = dot(vl, s.xyz);
         vec3 ll = 2.0 * vh * s.xyz - vl;
         if (vh <= 0.0 || ll.z <= 0.0 || s.w <= 0.0) {
@@ -126,20 +131,20 @@ vec3 environment_specular(realmat3 frame, vec3 v, float film_nm) {
         // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
         vec3 l = vec3(frame * real3(ll));
-        vec3 f = specular(frame, l, v, film_nm) * ll.z;
-        vec3 m = env_to_map(l);
-        sum += env_lookup(m, env_lod(m, pdf_l)) * (f / pdf_l);
+        vec3 f = specular(mat, frame, l, v, film_nm) * ll.z;
+        vec3 m = env_to_map(env, l);
+        sum += env_lookup(env, m, env_lod(env, m, pdf_l)) * (f / pdf_l);
     }
     return sum / float(ENV_SAMPLES);
 }
 
-vec3 environment_irradiance(vec3 n) {
-    vec3 d = env_to_map(n);
-    vec3 e = u_env_sh[0] + u_env_sh[1] * d.y + u_env_sh[2] * d.z + u_env_sh[3] * d.x
-             + u_env_sh[4] * (d.x * d.y) + u_env_sh[5] * (d.y * d.z)
-             + u_env_sh[6] * (3.0 * d.z * d.z - 1.0) + u_env_sh[7] * (d.x * d.z)
-             + u_env_sh[8] * (d.x * d.x - d.y * d.y);
-    return max(e, vec3(0.0)) * u_env_intensity;
+vec3 environment_irradiance(Environment env, vec3 n) {
+    vec3 d = env_to_map(env, n);
+    vec3 e = env.sh[0] + env.sh[1] * d.y + env.sh[2] * d.z + env.sh[3] * d.x
+             + env.sh[4] * (d.x * d.y) + env.sh[5] * (d.y * d.z)
+             + env.sh[6] * (3.0 * d.z * d.z - 1.0) + env.sh[7] * (d.x * d.z)
+             + env.sh[8] * (d.x * d.x - d.y * d.y);
+    return max(e, vec3(0.0)) * env.intensity;
 }
 
 #endif

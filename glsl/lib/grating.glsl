@@ -4,7 +4,11 @@
 //   η_m(λ)·F(v·h_m)·(v·h_m) / (|k_m|²·max(n·l, n·v))
 // (dω_h/dω_v = (v·h_m)/|k_m|²; for m = 0 this is the usual 1/(4 v·h)), with
 // η_m = J_m(a)², a = π·depth·(n·(l+v))/λ, a sinusoidal phase grating's efficiency.
-// Float64 twin: opaline/model/grating.py.
+// Float64 twin: opaline/model/grating.py. The grating's parameters come in the
+// Material (mat.grating). Contract: the program declares, before this file,
+//   float u_wavelength_nm[WAVELENGTHS];         with WAVELENGTHS > 0
+//   vec3 u_visible_density[VISIBLE_TABLE];      with WAVELENGTHS = 0: ŵ(λ) per nm,
+//                                               380 … 780 nm by 5 nm
 #ifndef GRATING_GLSL
 #define GRATING_GLSL
 #include "lib/common.glsl"
@@ -19,9 +23,7 @@
 #endif
 #define BESSEL_TERMS 16
 #define EPS_K2 1e-12
-
-uniform float u_grating_pitch_nm;
-uniform float u_grating_depth_nm;
+#define VISIBLE_TABLE 81  // glsl/material_params.glsl declares the table at this size
 
 // J_m(x) by its power series (x/2)^m/m! · Σ_k (-x²/4)^k·m!/(k!(k+m)!), summed by
 // Horner from the last term: a fixed count, no early exit, so it unrolls into
@@ -41,67 +43,65 @@ float bessel_j(int m, float x) {
     return lead * series;
 }
 
-float grating_efficiency(int m, float lam, float kn) {
-    float j = bessel_j(abs(m), PI * u_grating_depth_nm * max(kn, 0.0) / lam);
+float grating_efficiency(int m, float lam, float kn, float depth_nm) {
+    float j = bessel_j(abs(m), PI * depth_nm * max(kn, 0.0) / lam);
     return j * j;
 }
 
 // One order's lobe without η: k = (l+v) in the frame with its b component kb.
-float order_lobe(vec3 k, vec3 vl, float cos_max) {
+float order_lobe(Material mat, vec3 k, vec3 vl, float cos_max) {
     float k2 = max(dot(k, k), EPS_K2);
     float k_len = sqrt(k2);
     vec3 h = k / k_len;
     float vh = dot(vl, h);
 #ifdef FRESNEL
-    float f = fresnel_schlick(vh, u_f0);
+    float f = fresnel_schlick(vh, mat.f0);
 #else
     float f = 1.0;
 #endif
-    return f * mdf_ashikhmin(h.xy, h.z, u_ex, u_ey) * max(vh, 0.0) / (k2 * cos_max);
+    return f * mdf_ashikhmin(h.xy, h.z, mat.ex, mat.ey) * max(vh, 0.0) / (k2 * cos_max);
 }
 
 #if WAVELENGTHS > 0
-uniform float u_wavelength_nm[WAVELENGTHS];
-
 // Orders ±m at one wavelength: J_{-m}² = J_m², so one series serves both signs.
-float order_pair(int m, float lam, float step_b, vec3 k, vec3 vl, float cos_max) {
+float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, float cos_max) {
     float shift = float(m) * step_b;
-    float lobes = order_lobe(vec3(k.x, k.y - shift, k.z), vl, cos_max)
-                + order_lobe(vec3(k.x, k.y + shift, k.z), vl, cos_max);
-    return grating_efficiency(m, lam, k.z) * lobes;
+    float lobes = order_lobe(mat, vec3(k.x, k.y - shift, k.z), vl, cos_max)
+                + order_lobe(mat, vec3(k.x, k.y + shift, k.z), vl, cos_max);
+    return grating_efficiency(m, lam, k.z, mat.grating.depth_nm) * lobes;
 }
 
 // Σ_i w_i Σ_{|m| ≤ M} η_m(λ_i)·lobe_m(λ_i). The orders are written out, not looped:
 // with m a literal the Bessel series' divisors are constants (a loop over m this
 // large is not unrolled by Mesa, and its divisions cost a quarter of the draw).
-vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
-    float zero = order_lobe(k, vl, cos_max);  // the mirror order: the same at every λ
+    float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
     for (int i = 0; i < WAVELENGTHS; ++i) {
         float lam = u_wavelength_nm[i];
-        float step_b = lam / u_grating_pitch_nm;
-        float s = grating_efficiency(0, lam, k.z) * zero;
-        s += order_pair(1, lam, step_b, k, vl, cos_max);
+        float step_b = lam / mat.grating.pitch_nm;
+        float s = grating_efficiency(0, lam, k.z, mat.grating.depth_nm) * zero;
+        s += order_pair(mat, 1, lam, step_b, k, vl, cos_max);
 #if GRATING_ORDERS >= 2
-        s += order_pair(2, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 2, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 3
-        s += order_pair(3, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 3, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 4
-        s += order_pair(4, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 4, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 5
-        s += order_pair(5, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 5, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 6
-        s += order_pair(6, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 6, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 7
-        s += order_pair(7, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 7, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 8
-        s += order_pair(8, lam, step_b, k, vl, cos_max);
+        s += order_pair(mat, 8, lam, step_b, k, vl, cos_max);
 #endif
         sum += u_spectral_weight[i] * s;
     }
@@ -111,10 +111,6 @@ vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
 // Fast path: each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999),
 // the lobe's extent in λ integrated under a Gaussian approximation across the
 // grooves: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey).
-#define VISIBLE_TABLE 81
-uniform vec3 u_visible_density[VISIBLE_TABLE];  // ŵ(λ) per nm, 380 … 780 nm by 5 nm
-uniform vec3 u_channel_nm;                       // where η_0 is taken per channel
-
 vec3 visible_density(float lam) {
     float x = (lam - 380.0) / 5.0;
     if (!(x >= 0.0 && x <= float(VISIBLE_TABLE - 1))) {
@@ -124,39 +120,40 @@ vec3 visible_density(float lam) {
     return mix(u_visible_density[i], u_visible_density[i + 1], x - float(i));
 }
 
-vec3 grating_color(vec3 k, vec3 vl, float cos_max) {
+vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 k0 = vec3(k.x, 0.0, k.z);
-    float base = order_lobe(k0, vl, cos_max);
+    float base = order_lobe(mat, k0, vl, cos_max);
     float k0_len = sqrt(max(dot(k0, k0), EPS_K2));
-    float width = sqrt(TWO_PI / max(u_ey, 1.0));
+    float width = sqrt(TWO_PI / max(mat.ey, 1.0));
     vec3 sum = vec3(0.0);
     for (int m = 1; m <= GRATING_ORDERS; ++m) {
-        float spread = u_grating_pitch_nm / float(m) * k0_len * width;
+        float spread = mat.grating.pitch_nm / float(m) * k0_len * width;
         for (int sign = -1; sign <= 1; sign += 2) {
-            float lam = float(sign) * u_grating_pitch_nm * k.y / float(m);
+            float lam = float(sign) * mat.grating.pitch_nm * k.y / float(m);
             vec3 density = visible_density(lam);
             // Outside the visible range the order has no colour (and the Bessel
             // series would overflow float at the huge a of a tiny λ).
             if (density == vec3(0.0)) {
                 continue;
             }
-            sum += density * (spread * grating_efficiency(m, lam, k.z) * base);
+            sum += density * (spread * grating_efficiency(m, lam, k.z, mat.grating.depth_nm) * base);
         }
     }
-    float zero = order_lobe(k, vl, cos_max);
-    vec3 eta0 = vec3(grating_efficiency(0, u_channel_nm.r, k.z),
-                     grating_efficiency(0, u_channel_nm.g, k.z),
-                     grating_efficiency(0, u_channel_nm.b, k.z));
+    float zero = order_lobe(mat, k, vl, cos_max);
+    float depth = mat.grating.depth_nm;
+    vec3 eta0 = vec3(grating_efficiency(0, mat.grating.channel_nm.r, k.z, depth),
+                     grating_efficiency(0, mat.grating.channel_nm.g, k.z, depth),
+                     grating_efficiency(0, mat.grating.channel_nm.b, k.z, depth));
     return max(sum + zero * eta0, vec3(0.0));
 }
 #endif
 
-vec3 grating_specular(realmat3 frame, vec3 l, vec3 v) {
+vec3 grating_specular(Material mat, realmat3 frame, vec3 l, vec3 v) {
     vec3 k = vec3(transpose(frame) * (real3(l) + real3(v)));  // (·t, ·b, ·n)
     vec3 vl = vec3(transpose(frame) * real3(v));
     float nl = float(dot(frame[2], real3(l)));
     float cos_max = max(max(nl, vl.z), EPS_DENOM);
-    return grating_color(k, vl, cos_max);
+    return grating_color(mat, k, vl, cos_max);
 }
 
 #endif

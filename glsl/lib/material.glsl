@@ -1,67 +1,98 @@
 // The material's MDF per colour channel: the one MDF the variant was compiled
 // with, evaluated at the half vector rotated per channel (eq. 2), or per
 // wavelength and integrated to linear sRGB when WAVELENGTHS > 0 (docs/design.md §4.1).
+// The material comes in as a Material, filled once per fragment by the program
+// (glsl/material_params.glsl). Contract: with WAVELENGTHS > 0 the program declares,
+// before this file, the per-wavelength tables (copied into a struct they would cost
+// a copy per call):
+//   real2 u_spectral_rotation[WAVELENGTHS];  (cos θ(λ), sin θ(λ))
+//   vec3 u_spectral_weight[WAVELENGTHS];     its weight into linear sRGB
+// The iridescence sources' own tables are named at the top of their files.
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL
 #include "lib/common.glsl"
 #include "lib/rotation.glsl"
 
-// The material's scalar parameters are read here, once for the library: the MDFs
-// and Schlick's term (lib/mdf_*.glsl, lib/fresnel.glsl) take theirs as arguments.
 #if defined(MDF_ASHIKHMIN)
 #include "lib/mdf_ashikhmin.glsl"
-uniform float u_ex;
-uniform float u_ey;
-
-float mdf(real2 h, float hz) {
-    return mdf_ashikhmin(h, hz, u_ex, u_ey);
-}
 #elif defined(MDF_MULTIPEAK)
 #include "lib/mdf_multipeak.glsl"
-uniform real u_mu_f;
-uniform real u_alpha;
-uniform real u_beta;
-#ifdef AA_ANALYTIC
-uniform float u_aa_scale;
-#define MDF_AA_SCALE u_aa_scale
-#else
-#define MDF_AA_SCALE 1.0  // not read: no filter is compiled in
-#endif
-
-float mdf(real2 h, float hz) {
-    return mdf_multipeak(h, hz, u_mu_f, u_alpha, u_beta, MDF_AA_SCALE);
-}
 #else
 #error "define MDF_ASHIKHMIN or MDF_MULTIPEAK"
 #endif
 #ifdef FRESNEL
 #include "lib/fresnel.glsl"
-uniform float u_f0;
+#endif
+
+#ifdef IRIDESCENCE_THIN_FILM
+struct Film {  // lib/thin_film.glsl
+    float ior;
+    float substrate_ior;  // not read over a conductor: its n + ik is a table
+    float thickness_min;  // nm: a thickness map's 0
+    float thickness_max;  // nm: its 1, and the thickness without a map
+};
+#endif
+#ifdef IRIDESCENCE_GRATING
+struct Grating {  // lib/grating.glsl
+    float pitch_nm;
+    float depth_nm;
+#if WAVELENGTHS == 0
+    vec3 channel_nm;  // where η_0 is taken per channel
+#endif
+};
+#endif
+
+struct Material {
+#if defined(MDF_ASHIKHMIN)
+    float ex;
+    float ey;
+#else
+    real mu_f;
+    real alpha;
+    real beta;
+    float aa_scale;  // 1 where no filter is compiled in (AA_ANALYTIC off)
+#endif
+    float ks;
+    float kd;
+    vec3 albedo;
+    float f0;
+#if WAVELENGTHS == 0
+    real2 rotation[3];  // (cos θ, sin θ) for R, G, B: θ = 0, theta1, theta2
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+    Film film;
+#endif
+#ifdef IRIDESCENCE_GRATING
+    Grating grating;
+#endif
+};
+
+#if defined(MDF_ASHIKHMIN)
+float mdf(Material mat, real2 h, float hz) {
+    return mdf_ashikhmin(h, hz, mat.ex, mat.ey);
+}
+#else
+float mdf(Material mat, real2 h, float hz) {
+    return mdf_multipeak(h, hz, mat.mu_f, mat.alpha, mat.beta, mat.aa_scale);
+}
 #endif
 
 #if WAVELENGTHS > 0
-// Per wavelength: (cos θ(λ), sin θ(λ)) and its weight into linear sRGB
-// (CIE 1931 CMFs × XYZ→sRGB, white balanced so equal D gives equal RGB).
-uniform real2 u_spectral_rotation[WAVELENGTHS];
-uniform vec3 u_spectral_weight[WAVELENGTHS];
-
-vec3 mdf_color(real2 h, float hz) {
+// CIE 1931 CMFs × XYZ→sRGB, white balanced so equal D gives equal RGB.
+vec3 mdf_color(Material mat, real2 h, float hz) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < WAVELENGTHS; ++i) {
-        sum += u_spectral_weight[i] * mdf(rotate_half(h, u_spectral_rotation[i]), hz);
+        sum += u_spectral_weight[i] * mdf(mat, rotate_half(h, u_spectral_rotation[i]), hz);
     }
     // Colour matching weights go negative outside the sRGB gamut; radiance may not.
     return max(sum, vec3(0.0));
 }
 #else
-// (cos θ, sin θ) for R, G, B: θ = 0, theta1, theta2.
-uniform real2 u_rotation[3];
-
-vec3 mdf_color(real2 h, float hz) {
+vec3 mdf_color(Material mat, real2 h, float hz) {
     return vec3(
-        mdf(rotate_half(h, u_rotation[0]), hz),
-        mdf(rotate_half(h, u_rotation[1]), hz),
-        mdf(rotate_half(h, u_rotation[2]), hz));
+        mdf(mat, rotate_half(h, mat.rotation[0]), hz),
+        mdf(mat, rotate_half(h, mat.rotation[1]), hz),
+        mdf(mat, rotate_half(h, mat.rotation[2]), hz));
 }
 #endif
 

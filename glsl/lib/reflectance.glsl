@@ -12,31 +12,25 @@
 #include "lib/grating.glsl"
 #endif
 
-uniform float u_ks;
-#ifdef DIFFUSE
-uniform float u_kd;
-uniform vec3 u_albedo;
-#endif
-
 #ifdef IRIDESCENCE_THIN_FILM
 #ifdef FILM_PER_PIXEL
 // Environment light evaluates the film once per pixel (lib/environment_light.glsl).
 vec3 g_film_colour;
-vec3 film_colour(float vh, float film_nm) {
+vec3 film_colour(Material mat, float vh, float film_nm) {
     return g_film_colour;
 }
 #else
-vec3 film_colour(float vh, float film_nm) {
-    return film_rgb(vh, film_thickness_nm(film_nm));
+vec3 film_colour(Material mat, float vh, float film_nm) {
+    return film_rgb(mat.film, vh, film_thickness_nm(mat.film, film_nm));
 }
 #endif
 #endif
 
 // film_nm: the thin film's thickness here (negative: the material's maximum, as KHR's
 // without a thickness texture); not read by the other sources.
-vec3 specular(realmat3 frame, vec3 l, vec3 v, float film_nm) {
+vec3 specular(Material mat, realmat3 frame, vec3 l, vec3 v, float film_nm) {
 #ifdef IRIDESCENCE_GRATING
-    return u_ks * grating_specular(frame, l, v);
+    return mat.ks * grating_specular(mat, frame, l, v);
 #else
     real3 sum_lv = real3(l) + real3(v);
     real len = length(sum_lv);
@@ -49,26 +43,26 @@ vec3 specular(realmat3 frame, vec3 l, vec3 v, float film_nm) {
     float vh = float(dot(real3(v), h));
 #ifdef IRIDESCENCE_THIN_FILM
     // The unrotated lobe, coloured by the film instead of by rotation (Fresnel off).
-    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), u_ex, u_ey) * film_colour(vh, film_nm);
+    vec3 d = mdf_ashikhmin(hl.xy, float(hl.z), mat.ex, mat.ey) * film_colour(mat, vh, film_nm);
 #else
-    vec3 d = mdf_color(hl.xy, float(hl.z));
+    vec3 d = mdf_color(mat, hl.xy, float(hl.z));
 #endif
     float nl = float(dot(frame[2], real3(l)));
     float nv = float(dot(frame[2], real3(v)));
 #ifdef FRESNEL
-    float f = fresnel_schlick(vh, u_f0);
+    float f = fresnel_schlick(vh, mat.f0);
 #else
     float f = 1.0;
 #endif
     float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return u_ks * d * (f / denom);
+    return mat.ks * d * (f / denom);
 #endif
 }
 
-vec3 reflected_radiance(realmat3 frame, vec3 l, vec3 v, float film_nm) {
-    vec3 f = specular(frame, l, v, film_nm);
+vec3 reflected_radiance(Material mat, realmat3 frame, vec3 l, vec3 v, float film_nm) {
+    vec3 f = specular(mat, frame, l, v, film_nm);
 #ifdef DIFFUSE
-    f += u_kd * u_albedo / PI;
+    f += mat.kd * mat.albedo / PI;
 #endif
     return f * max(float(dot(frame[2], real3(l))), 0.0);
 }

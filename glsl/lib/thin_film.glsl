@@ -1,26 +1,26 @@
 // Thin-film colour (docs/physics.md §1): Airy reflectance of a film of index
-// u_film_ior and thickness d (nm) on a substrate of index u_substrate_ior, under
+// film.ior and thickness d (nm) on a substrate of index film.substrate_ior, under
 // air, at cos θ1 = v·h. Real indices make the Fresnel amplitudes a = r12 and
 // b = r23 real and signed (the sign is the interface's 0 or π phase shift):
 //   R(φ) = (a² + b² + 2ab·cos φ) / (1 + a²b² + 2ab·cos φ),  φ = 4π·n·d·cos θ2/λ,
 // averaged over s and p; total internal reflection gives 1. Under a conductor
 // (SUBSTRATE_CONDUCTOR) the index below is complex, n + ik, and so is b: the same
 // sum is exact with b·cos φ replaced by Re(b·e^{iφ}) (b's phase adds to the film's).
-// Float64 twin: opaline/model/thinfilm.py.
+// Float64 twin: opaline/model/thinfilm.py. The film comes in as a Film (mat.film,
+// lib/material.glsl). Contract: the program declares, before this file, the tables
+//   float u_wavelength_nm[WAVELENGTHS];           with WAVELENGTHS > 0
+//   vec3 u_film_sens_weight[3], u_film_sens_centre[3], u_film_sens_sigma[3];
+//                                                 with WAVELENGTHS = 0 (see film_rgb)
+//   vec2 u_substrate_nk[WAVELENGTHS, or 3 for R, G, B];  with SUBSTRATE_CONDUCTOR
 #ifndef THIN_FILM_GLSL
 #define THIN_FILM_GLSL
 #include "lib/common.glsl"
 #include "lib/material.glsl"
 
-uniform float u_film_ior;
-uniform float u_substrate_ior;
-uniform float u_film_thickness_min;
-uniform float u_film_thickness_max;
-
 // A fragment's thickness in nm from what its caller knows: its thickness field's value,
 // or negative (the probe, a surface without a field) for the maximum, as in KHR.
-float film_thickness_nm(float film_nm) {
-    return film_nm >= 0.0 ? film_nm : u_film_thickness_max;
+float film_thickness_nm(Film film, float film_nm) {
+    return film_nm >= 0.0 ? film_nm : film.thickness_max;
 }
 
 float film_ratio(float num, float den) {
@@ -28,10 +28,10 @@ float film_ratio(float num, float den) {
 }
 
 // Both interfaces for s (.x) and p (.y); false where light cannot get through.
-bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
+bool film_interfaces(Film film, float cos1, out float cos2, out vec2 r12, out vec2 r23) {
     cos1 = clamp(cos1, 0.0, 1.0);
-    float nf = u_film_ior;
-    float ns = u_substrate_ior;
+    float nf = film.ior;
+    float ns = film.substrate_ior;
     // cos²θ2 = 1 - sin²θ1/n² as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1 rounds
     // to 1 in float, which would turn a film of index 1 into total reflection.
     float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
@@ -48,8 +48,6 @@ bool film_interfaces(float cos1, out float cos2, out vec2 r12, out vec2 r23) {
 #ifdef SUBSTRATE_CONDUCTOR
 #include "lib/thin_film_conductor.glsl"
 #elif WAVELENGTHS > 0
-uniform float u_wavelength_nm[WAVELENGTHS];
-
 float film_airy(float a, float b, float c) {
     float ab = a * b;
     // The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
@@ -57,13 +55,13 @@ float film_airy(float a, float b, float c) {
 }
 
 // Σ_i w_i·R(λ_i), with the CIE weights of the spectral path (material.glsl).
-vec3 film_rgb(float cos1, float d) {
+vec3 film_rgb(Film film, float cos1, float d) {
     float cos2;
     vec2 r12, r23;
-    if (!film_interfaces(cos1, cos2, r12, r23)) {
+    if (!film_interfaces(film, cos1, cos2, r12, r23)) {
         return vec3(1.0);
     }
-    float opd = 2.0 * u_film_ior * d * cos2;  // nm
+    float opd = 2.0 * film.ior * d * cos2;  // nm
     vec3 sum = vec3(0.0);
     for (int i = 0; i < WAVELENGTHS; ++i) {
         // φ in cycles, reduced before the cosine: float trig never sees a big argument.
@@ -85,18 +83,17 @@ vec3 film_rgb(float cos1, float d) {
 // (Chebyshev for cos mθ, powers for d^(m²)), shared by s and p; the terms m > 3,
 // which matter near grazing where |q| nears 1, are summed as the geometric series
 // Re(z⁴/(1 - z)), z = q·e^{iθ}, damped as the term m = 4. The float64 twin
-// (model/thinfilm.py) evaluates the same sums term by term.
-uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
-uniform vec3 u_film_sens_centre[3];  // µm⁻¹
-uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
+// (model/thinfilm.py) evaluates the same sums term by term. The tables, per
+// Gaussian k and channel: u_film_sens_weight its integral, u_film_sens_centre μ_k
+// and u_film_sens_sigma σ_k in µm⁻¹.
 
-vec3 film_rgb(float cos1, float d) {
+vec3 film_rgb(Film film, float cos1, float d) {
     float cos2;
     vec2 r12, r23;
-    if (!film_interfaces(cos1, cos2, r12, r23)) {
+    if (!film_interfaces(film, cos1, cos2, r12, r23)) {
         return vec3(1.0);
     }
-    float opd_um = 2e-3 * u_film_ior * d * cos2;
+    float opd_um = 2e-3 * film.ior * d * cos2;
     vec2 x = r12 * r23;  // (s, p)
     vec2 one_minus = max(1.0 - x * x, 1e-30);
     vec2 c0 = (r12 * r12 + r23 * r23 - 2.0 * x * x) / one_minus;

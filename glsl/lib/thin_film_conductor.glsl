@@ -31,8 +31,7 @@ vec2 c_sqrt(vec2 z) {
 
 // The film's top interface (s, p), as film_interfaces; false where light cannot enter,
 // and exactly at grazing, where all is reflected (over a lossless ñ = 1 Airy is 0/0).
-bool film_top(float cos1, out float cos2, out vec2 r12) {
-    float nf = u_film_ior;
+bool film_top(float nf, float cos1, out float cos2, out vec2 r12) {
     float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
     cos2 = sqrt(max(cos2_sq, 0.0));
     r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
@@ -42,8 +41,7 @@ bool film_top(float cos1, out float cos2, out vec2 r12) {
 
 // The lower interface over ñ = nk: complex r23 for s (.xy) and p (.zw), with
 // ñ·cos θ3 = √(ñ² - sin²θ1).
-vec4 film_conductor_r23(float cos1, float cos2, vec2 nk) {
-    float nf = u_film_ior;
+vec4 film_conductor_r23(float nf, float cos1, float cos2, vec2 nk) {
     vec2 n_sq = c_mul(nk, nk);
     // (ñ² - 1) + cos²θ1, in that order, as the dielectric's cos²θ3: near grazing
     // cos²θ1 - 1 rounds to -1 in float, which would turn ñ = 1 into a mirror.
@@ -55,9 +53,7 @@ vec4 film_conductor_r23(float cos1, float cos2, vec2 nk) {
 }
 
 #if WAVELENGTHS > 0
-uniform float u_wavelength_nm[WAVELENGTHS];
-uniform vec2 u_substrate_nk[WAVELENGTHS];  // n + ik at each wavelength
-
+// u_substrate_nk: n + ik at each wavelength.
 // One polarisation: a real, b complex, e = e^{iφ}.
 float film_airy_complex(float a, vec2 b, vec2 e) {
     float b2 = dot(b, b);
@@ -65,17 +61,17 @@ float film_airy_complex(float a, vec2 b, vec2 e) {
     return max(a * a + b2 + 2.0 * a * re, 0.0) / max(1.0 + a * a * b2 + 2.0 * a * re, 1e-30);
 }
 
-vec3 film_rgb(float cos1, float d) {
+vec3 film_rgb(Film film, float cos1, float d) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float cos2;
     vec2 r12;
-    if (!film_top(cos1, cos2, r12)) {
+    if (!film_top(film.ior, cos1, cos2, r12)) {
         return vec3(1.0);
     }
-    float opd = 2.0 * u_film_ior * d * cos2;  // nm
+    float opd = 2.0 * film.ior * d * cos2;  // nm
     vec3 sum = vec3(0.0);
     for (int i = 0; i < WAVELENGTHS; ++i) {
-        vec4 r23 = film_conductor_r23(cos1, cos2, u_substrate_nk[i]);
+        vec4 r23 = film_conductor_r23(film.ior, cos1, cos2, u_substrate_nk[i]);
         // φ in cycles, reduced before the trigonometry, as the dielectric path.
         float phase = TWO_PI * fract(opd / u_wavelength_nm[i]);
         vec2 e = vec2(cos(phase), sin(phase));
@@ -89,13 +85,10 @@ vec3 film_rgb(float cos1, float d) {
 // one n + ik per channel (its colour weight's average) and so one complex b per
 // channel and polarisation: |b| in the coefficients, b's phase ψ added to every
 // Gaussian's θ_k = 2π·μ_k·opd + ψ. The sign of q = -a|b| carries the π shift.
-uniform vec3 u_film_sens_weight[3];  // each Gaussian's integral, per channel
-uniform vec3 u_film_sens_centre[3];  // µm⁻¹
-uniform vec3 u_film_sens_sigma[3];   // µm⁻¹
-uniform vec2 u_substrate_nk[3];      // n + ik per channel (R, G, B)
+// u_substrate_nk: n + ik per channel (R, G, B).
 
-float film_channel(int c, float cos1, float cos2, vec2 r12, float opd_um) {
-    vec4 r23 = film_conductor_r23(cos1, cos2, u_substrate_nk[c]);
+float film_channel(int c, float nf, float cos1, float cos2, vec2 r12, float opd_um) {
+    vec4 r23 = film_conductor_r23(nf, cos1, cos2, u_substrate_nk[c]);
     float value = 0.0;
     for (int pol = 0; pol < 2; ++pol) {
         vec2 b = pol == 0 ? r23.xy : r23.zw;
@@ -124,17 +117,17 @@ float film_channel(int c, float cos1, float cos2, vec2 r12, float opd_um) {
     return value;
 }
 
-vec3 film_rgb(float cos1, float d) {
+vec3 film_rgb(Film film, float cos1, float d) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float cos2;
     vec2 r12;
-    if (!film_top(cos1, cos2, r12)) {
+    if (!film_top(film.ior, cos1, cos2, r12)) {
         return vec3(1.0);
     }
-    float opd_um = 2e-3 * u_film_ior * d * cos2;
-    vec3 rgb = vec3(film_channel(0, cos1, cos2, r12, opd_um),
-                    film_channel(1, cos1, cos2, r12, opd_um),
-                    film_channel(2, cos1, cos2, r12, opd_um));
+    float opd_um = 2e-3 * film.ior * d * cos2;
+    vec3 rgb = vec3(film_channel(0, film.ior, cos1, cos2, r12, opd_um),
+                    film_channel(1, film.ior, cos1, cos2, r12, opd_um),
+                    film_channel(2, film.ior, cos1, cos2, r12, opd_um));
     return max(rgb, vec3(0.0));
 }
 #endif

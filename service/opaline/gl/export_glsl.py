@@ -28,7 +28,7 @@ GLSL_TYPES = {"real": "float", "real2": "vec2", "real3": "vec3"}
 ENTRY = """
 // The exported entry point.
 vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
-    return vec3(reflected_radiance(shading_frame(real3(n), real3(t)), l, v, -1.0));
+    return vec3(reflected_radiance(material_params(), shading_frame(real3(n), real3(t)), l, v, -1.0));
 }
 """
 
@@ -83,7 +83,8 @@ def export_glsl(material: Material, wavelengths: int = 0) -> str:
         value = defines[key]
         if value is not False:
             lines.append(f"#define {key}" if value is True else f"#define {key} {int(value)}")
-    for line in expand("lib/reflectance.glsl", []):
+    files: list[str] = []
+    for line in expand("material_params.glsl", files) + expand("lib/reflectance.glsl", files):
         if line.startswith("#line"):
             continue
         match = UNIFORM.match(line)

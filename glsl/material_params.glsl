@@ -1,0 +1,113 @@
+// The material's parameters as gl/material_program.py sets them, by name, and the
+// Material the library takes (lib/material.glsl), filled from them. Included by the
+// programs that shade the material, and by the GLSL export (gl/export_glsl.py),
+// which turns each of these declarations into a constant.
+#ifndef MATERIAL_PARAMS_GLSL
+#define MATERIAL_PARAMS_GLSL
+#include "lib/common.glsl"
+#if WAVELENGTHS > 0
+uniform real2 u_spectral_rotation[WAVELENGTHS];
+uniform vec3 u_spectral_weight[WAVELENGTHS];
+#endif
+#if WAVELENGTHS > 0 && (defined(IRIDESCENCE_THIN_FILM) || defined(IRIDESCENCE_GRATING))
+uniform float u_wavelength_nm[WAVELENGTHS];
+#endif
+#if WAVELENGTHS == 0 && defined(IRIDESCENCE_THIN_FILM)
+uniform vec3 u_film_sens_weight[3];
+uniform vec3 u_film_sens_centre[3];
+uniform vec3 u_film_sens_sigma[3];
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR) && WAVELENGTHS > 0
+uniform vec2 u_substrate_nk[WAVELENGTHS];
+#elif defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR)
+uniform vec2 u_substrate_nk[3];
+#endif
+#if WAVELENGTHS == 0 && defined(IRIDESCENCE_GRATING)
+uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
+#endif
+#include "lib/material.glsl"
+
+#if defined(MDF_ASHIKHMIN)
+uniform float u_ex;
+uniform float u_ey;
+#else
+uniform real u_mu_f;
+uniform real u_alpha;
+uniform real u_beta;
+#ifdef AA_ANALYTIC
+uniform float u_aa_scale;
+#endif
+#endif
+uniform float u_ks;
+#ifdef DIFFUSE
+uniform float u_kd;
+uniform vec3 u_albedo;
+#endif
+#ifdef FRESNEL
+uniform float u_f0;
+#endif
+#if WAVELENGTHS == 0
+uniform real2 u_rotation[3];
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+uniform float u_film_ior;
+uniform float u_substrate_ior;
+uniform float u_film_thickness_min;
+uniform float u_film_thickness_max;
+#endif
+#ifdef IRIDESCENCE_GRATING
+uniform float u_grating_pitch_nm;
+uniform float u_grating_depth_nm;
+#if WAVELENGTHS == 0
+uniform vec3 u_channel_nm;
+#endif
+#endif
+
+Material material_params() {
+    Material mat;
+#if defined(MDF_ASHIKHMIN)
+    mat.ex = u_ex;
+    mat.ey = u_ey;
+#else
+    mat.mu_f = u_mu_f;
+    mat.alpha = u_alpha;
+    mat.beta = u_beta;
+#ifdef AA_ANALYTIC
+    mat.aa_scale = u_aa_scale;
+#else
+    mat.aa_scale = 1.0;
+#endif
+#endif
+    mat.ks = u_ks;
+#ifdef DIFFUSE
+    mat.kd = u_kd;
+    mat.albedo = u_albedo;
+#else
+    mat.kd = 0.0;  // not read: no diffuse term is compiled in
+    mat.albedo = vec3(0.0);
+#endif
+#ifdef FRESNEL
+    mat.f0 = u_f0;
+#else
+    mat.f0 = 0.0;  // not read: Fresnel is off
+#endif
+#if WAVELENGTHS == 0
+    mat.rotation = u_rotation;
+#endif
+#ifdef IRIDESCENCE_THIN_FILM
+    mat.film.ior = u_film_ior;
+    mat.film.substrate_ior = u_substrate_ior;
+    mat.film.thickness_min = u_film_thickness_min;
+    mat.film.thickness_max = u_film_thickness_max;
+#endif
+#ifdef IRIDESCENCE_GRATING
+    mat.grating.pitch_nm = u_grating_pitch_nm;
+    mat.grating.depth_nm = u_grating_depth_nm;
+#if WAVELENGTHS == 0
+    mat.grating.channel_nm = u_channel_nm;
+#endif
+#endif
+    return mat;
+}
+
+#endif
