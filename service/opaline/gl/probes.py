@@ -8,6 +8,9 @@ against the float64 reference case by case.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+
 import moderngl
 import numpy as np
 
@@ -20,6 +23,45 @@ from opaline.model.params import Material
 LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4,
               "sequence": 5}
 
+
+
+def case_grid(count: int) -> tuple[int, int]:
+    """The probe target's size for ``count`` cases, one a pixel, rows of at most 256."""
+    width = min(count, 256)
+    return width, -(-count // width)
+
+
+@contextmanager
+def case_textures(res: Resources, cases: Sequence[np.ndarray]) -> Iterator[None]:
+    """Each (count, 3) input as a float texture on units 0, 1, ...: case i at pixel
+    (i % width, i // width), read with texelFetch; released on the way out."""
+    count = len(cases[0])
+    width, height = case_grid(count)
+    textures = []
+    try:
+        for unit, data in enumerate(cases):
+            grid = np.zeros((height * width, 4), dtype="f4")
+            grid[:count, :3] = data
+            textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
+            textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
+            textures[-1].use(location=unit)
+        yield
+    finally:
+        for texture in textures:
+            texture.release()
+
+
+def draw_cases(res: Resources, program: moderngl.Program, count: int) -> np.ndarray:
+    """One full-screen draw of a probe program: (count, 4), case order."""
+    width, height = case_grid(count)
+    targets = res.targets((width, height))
+    targets.display_fbo.use()
+    res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
+    res.fullscreen(program)
+    image = read_float(targets.display_fbo, (width, height))
+    # Case i sits at GL row i // width; read() gave image order (top row first).
+    result: np.ndarray = image[::-1].reshape(-1, 4)[:count]
+    return result
 
 class Probes:
     """The plot and the probe, drawn with the renderer's resources (the renderer hands
@@ -57,70 +99,33 @@ class Probes:
         """Reflected radiance for each (n, t, l, v) case through the surface shading code."""
         res = self.resources
         res.gl.make_current()
-        count = len(n)
-        width = min(count, 256)
-        height = -(-count // width)
         # aa stays "none" (AA_ANALYTIC false, so not compiled in): a probe has no pixel footprint.
         defines = material_program.material_defines(material, wavelengths)
         defines["PRECISE_PHASE"] = res.gl.has_fp64
         program = res.programs.get("brdf_probe.glsl", defines)
-        textures = []
-        try:
-            for unit, (name, data) in enumerate(
-                (("u_normal", n), ("u_tangent", t), ("u_light", l), ("u_view", v))
-            ):
-                grid = np.zeros((height * width, 4), dtype="f4")
-                grid[:count, :3] = data
-                tex = res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4")
-                textures.append(tex)
-                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                tex.use(location=unit)
+        with case_textures(res, (n, t, l, v)):
+            for unit, name in enumerate(("u_normal", "u_tangent", "u_light", "u_view")):
                 program[name] = unit
             uniforms.apply(program, material_program.material_uniforms(material, wavelengths))
-            targets = res.targets((width, height))
-            targets.display_fbo.use()
-            res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-            res.fullscreen(program)
-            image = read_float(targets.display_fbo, (width, height))
-        finally:
-            for tex in textures:
-                tex.release()
-        # Case i sits at GL row i // width; read() gave image order (top row first).
-        return image[::-1].reshape(-1, 4)[:count, :3]
+            return draw_cases(res, program, len(n))[:, :3]
 
     def triplanar(self, q: np.ndarray, n: np.ndarray, texels: np.ndarray) -> np.ndarray:
         """glsl/lib/triplanar.glsl for each (projection coordinate, object normal) case, on
         an RGBA float map (row 0 at v = 0): (count, 4), blended normal and scalar."""
         res = self.resources
         res.gl.make_current()
-        count = len(q)
-        width = min(count, 256)
-        height = -(-count // width)
         program = res.programs.get("triplanar_probe.glsl", {})
-        textures = []
+        program["u_position"], program["u_normal"] = 0, 1
+        rows, cols = texels.shape[:2]
+        texture = res.ctx.texture((cols, rows), 4, texels.astype("f4").tobytes(), dtype="f4")
         try:
-            for unit, (name, data) in enumerate((("u_position", q), ("u_normal", n))):
-                grid = np.zeros((height * width, 4), dtype="f4")
-                grid[:count, :3] = data
-                textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
-                textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
-                textures[-1].use(location=unit)
-                program[name] = unit
-            rows, cols = texels.shape[:2]
-            textures.append(res.ctx.texture((cols, rows), 4, texels.astype("f4").tobytes(),
-                                            dtype="f4"))
-            textures[-1].repeat_x = textures[-1].repeat_y = True
-            textures[-1].use(location=2)
-            program["u_map"] = 2
-            targets = res.targets((width, height))
-            targets.display_fbo.use()
-            res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-            res.fullscreen(program)
-            image = read_float(targets.display_fbo, (width, height))
+            with case_textures(res, (q, n)):
+                texture.repeat_x = texture.repeat_y = True
+                texture.use(location=2)
+                program["u_map"] = 2
+                return draw_cases(res, program, len(q))
         finally:
-            for tex in textures:
-                tex.release()
-        return image[::-1].reshape(-1, 4)[:count]
+            texture.release()
 
     def lobe(self, material: Material, mode: str, cases: tuple[np.ndarray, ...],
              environment: tuple[moderngl.Texture, np.ndarray] | None = None,
@@ -133,9 +138,6 @@ class Probes:
         ``brute`` level 0 always (else the filtered read, for ``samples · passes`` in all)."""
         res = self.resources
         res.gl.make_current()
-        count = len(cases[0])
-        width = min(count, 256)
-        height = -(-count // width)
         defines = {**material_program.material_defines(material), "ENV_SAMPLES": samples,
                    "ENV_BRUTE": brute}
         program = res.programs.get("lobe_probe.glsl", defines)
@@ -151,27 +153,12 @@ class Probes:
                            "u_env_size": (float(texture.width), float(texture.height)),
                            "u_env_max_lod": float(np.floor(np.log2(max(texture.size)))),
                            "u_env_sh": [tuple(map(float, c)) for c in sh]})
-        textures = []
-        try:
-            for unit, data in enumerate(cases):
-                grid = np.zeros((height * width, 4), dtype="f4")
-                grid[:count, :3] = data
-                textures.append(res.ctx.texture((width, height), 4, grid.tobytes(), dtype="f4"))
-                textures[-1].filter = (moderngl.NEAREST, moderngl.NEAREST)
-                textures[-1].use(location=unit)
-                values["u_case_" + "abc"[unit]] = unit
+        values.update({"u_case_" + "abc"[unit]: unit for unit in range(len(cases))})
+        results = []
+        with case_textures(res, cases):
             uniforms.apply(program, values)
-            targets = res.targets((width, height))
-            results = []
             for index in range(passes):
                 if "u_env_pass" in program:
                     program["u_env_pass"] = index
-                targets.display_fbo.use()
-                res.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST)
-                res.fullscreen(program)
-                image = read_float(targets.display_fbo, (width, height))
-                results.append(image[::-1].reshape(-1, 4)[:count])
-        finally:
-            for tex in textures:
-                tex.release()
+                results.append(draw_cases(res, program, len(cases[0])))
         return np.stack(results)
