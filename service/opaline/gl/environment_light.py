@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import math
 
+import moderngl
 import numpy as np
 
 from opaline.gl import texture_units
 from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
+from opaline.model.params import Material
 from opaline.model.request import Job
 
 # From this many samples a pixel, the film is evaluated at each sample's own v·h; below,
@@ -42,23 +44,32 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             "LIGHT_COUNT": lights if lights else False}
 
 
+def map_uniforms(texture: moderngl.Texture, irradiance: np.ndarray) -> Uniforms:
+    """What the shader reads of the map itself (the surface's and the lobe probe's)."""
+    width, height = texture.size
+    return {"u_env_map": texture_units.ENVIRONMENT,
+            "u_env_size": (float(width), float(height)),
+            "u_env_max_lod": float(math.floor(math.log2(max(width, height)))),
+            "u_env_sh": [tuple(map(float, c)) for c in irradiance]}
+
+
+def lobe_rotations(material: Material) -> list[tuple[float, float]]:
+    """(cos, sin) of the three lobes the rotation source samples: 0, theta1, theta2."""
+    return [(math.cos(a), math.sin(a)) for a in (0.0, material.theta1, material.theta2)]
+
+
 def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap) -> Uniforms:
-    width, height = environment.texture.size
     per_pixel = samples_per_pass(job, samples) * samples.passes * samples.factor ** 2
     material = job.material
     rotation = math.radians(job.environment_rotation or 0.0)
     intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
     values: Uniforms = {
-        "u_env_map": texture_units.ENVIRONMENT,
+        **map_uniforms(environment.texture, environment.irradiance),
         "u_env_rotation": rotation,
         "u_env_intensity": intensity,
-        "u_env_size": (float(width), float(height)),
-        "u_env_max_lod": float(math.floor(math.log2(max(width, height)))),
         "u_env_total": float(per_pixel),
         "u_env_pass": 0,
-        "u_env_lobe_rotation": [(math.cos(a), math.sin(a))
-                                for a in (0.0, material.theta1, material.theta2)],
-        "u_env_sh": [tuple(map(float, c)) for c in environment.irradiance],
+        "u_env_lobe_rotation": lobe_rotations(material),
     }
     if len(environment.light_directions):
         # The map turns by +rotation about +y (atan2(z, x) grows): its lights with it.

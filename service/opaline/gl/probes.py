@@ -14,7 +14,7 @@ from contextlib import contextmanager
 import moderngl
 import numpy as np
 
-from opaline.gl import material_program, texture_units, uniforms
+from opaline.gl import environment_light, material_program, texture_units, uniforms
 from opaline.gl.buffers import read_float
 from opaline.gl.resources import Resources
 from opaline.model.params import Material
@@ -144,15 +144,11 @@ class Probes:
         values = material_program.material_uniforms(material)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,
                        "u_env_intensity": intensity, "u_env_total": float(samples * passes),
-                       "u_env_lobe_rotation": [(np.cos(a), np.sin(a)) for a in
-                                               (0.0, material.theta1, material.theta2)]})
+                       "u_env_lobe_rotation": environment_light.lobe_rotations(material)})
         if environment is not None:
             texture, sh = environment
             texture.use(location=texture_units.ENVIRONMENT)
-            values.update({"u_env_map": texture_units.ENVIRONMENT,
-                           "u_env_size": (float(texture.width), float(texture.height)),
-                           "u_env_max_lod": float(np.floor(np.log2(max(texture.size)))),
-                           "u_env_sh": [tuple(map(float, c)) for c in sh]})
+            values.update(environment_light.map_uniforms(texture, sh))
         values.update({"u_case_" + "abc"[unit]: unit for unit in range(len(cases))})
         results = []
         with case_textures(res, cases):
