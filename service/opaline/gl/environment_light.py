@@ -21,11 +21,12 @@ from opaline.gl.uniforms import Uniforms
 from opaline.model.params import Material
 from opaline.model.request import Job
 
-# From this many samples a pixel, the film is evaluated at each sample's own v·h; below,
-# once at n·v. Measured against the brute-force reference (bench/environment_accuracy.py,
-# studio, 128²): once per pixel costs FLIP +0.000-0.005 at 2-4 samples, where it makes a
-# standard-tier film 1.1-1.3× its key-lit time instead of 2-2.8×, but leaves a floor
-# near 0.01 that the high tier (64 samples, 0.003-0.006 exact) should not have.
+# From this many samples a pixel, the film is evaluated at each sample's own v·h; below
+# (draft's 2, standard's 6), once at n·v. Measured against the brute-force reference
+# (bench/environment_accuracy.py, studio, 128²): once per pixel costs FLIP +0.000-0.005
+# at 2-4 samples, where it makes a standard-tier film 1.1-1.3× its key-lit time instead
+# of 2-2.8×, but leaves a floor near 0.01 that the high tier (64 samples, 0.003-0.006
+# exact) should not have.
 FILM_PER_SAMPLE_FROM = 48
 
 
