@@ -61,7 +61,7 @@ def failure_of(exc: Exception) -> dict[str, Any]:
             "fields": exc.field_problems()}
 
 
-CANCELLED = {"status": 409, "reason": "cancelled", "retry_later": False, "retry_after_s": None,
+CANCELLED = {"status": 404, "reason": "cancelled", "retry_later": False, "retry_after_s": None,
              "lines": ["the turntable was cancelled (DELETE): POST it again to start it anew"],
              "fields": []}
 

@@ -6,10 +6,11 @@ Each frame is an ordinary render job (cached, deduplicated, admitted, run by
 the workers); a worker then encodes the frames. The cost budget covers all
 frames. Progress is the count of finished frames. At most ``max_turntables`` run
 at once on a replica (one more is 429 ``busy`` with Retry-After).
-Failures answer in the public shape: 404 ``unknown_turntable``, 409
-``rendering`` (or ``cancelled``), and a failed turntable's result answers its failure's own
-status (422 ``too_slow``, 503 ``deadline`` ...); a state store that does not
-answer is 503 ``store_unavailable``.
+Failures answer in the public shape: 404 ``unknown_turntable``, 404 ``cancelled``
+(after a DELETE, both reads: never a 2xx for what was deleted), 409 ``rendering``,
+and a failed turntable's result answers its failure's own status (422
+``too_slow``, 503 ``deadline`` ...); a state store that does not answer is 503
+``store_unavailable``.
 """
 
 from __future__ import annotations
@@ -51,19 +52,19 @@ BUSY = {"model": Problem, "headers": RETRY_AFTER,
                        "rendering; retry after Retry-After seconds."}
 UNKNOWN_LINE = ("error 'unknown_turntable': never started here, or forgotten (the service "
                 "keeps the latest 64).")
+CANCELLED_LINE = " error 'cancelled': DELETE cancelled it; POST it again to start it anew."
 UNKNOWN = {"model": Problem, "description": UNKNOWN_LINE}
+READ_404 = {"model": Problem, "description": UNKNOWN_LINE + CANCELLED_LINE}
 RESULT_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The animation: animated WebP, GIF or MP4.",
           "content": {t: {"schema": {"type": "string", "format": "binary"}}
                       for t in MEDIA_TYPES.values()}},
     **ERROR_RESPONSES,
-    404: {"model": Problem, "description": UNKNOWN_LINE + " Also: its animation "
-                                           "was forgotten (a byte budget keeps the latest); "
-                                           "POST it again."},
+    404: {"model": Problem, "description": UNKNOWN_LINE + CANCELLED_LINE + " Also: its "
+                                           "animation was forgotten (a byte budget keeps the "
+                                           "latest); POST it again."},
     409: {"model": Problem, "description": "error 'rendering': the frames are not all done yet; "
-                                           "GET /v1/turntables/{id} tells how far it is. "
-                                           "error 'cancelled': DELETE cancelled it; POST it "
-                                           "again to start it anew."},
+                                           "GET /v1/turntables/{id} tells how far it is."},
     422: {"model": Problem, "description": "The turntable failed: a frame is over the "
                                            "service's limits (too_slow)."},
     503: {"model": Problem, "headers": RETRY_AFTER,
@@ -108,7 +109,7 @@ async def restartable(found: Turntables, record: Record) -> bool:
 
 @router.delete("/v1/turntables/{turntable_id}", tags=["turntables"], status_code=202,
                responses={**ERROR_RESPONSES, 404: UNKNOWN},
-               summary="Cancel a turntable: it stops, and GET then says cancelled")
+               summary="Cancel a turntable: it stops, and GET then answers 404 cancelled")
 async def turntable_delete(turntable_id: str, found: TurntablesDep) -> TurntableStatus:
     record = await found.cancel(turntable_id)
     if record is None:
@@ -117,7 +118,7 @@ async def turntable_delete(turntable_id: str, found: TurntablesDep) -> Turntable
 
 
 @router.get("/v1/turntables/{turntable_id}", tags=["turntables"],
-            responses={**ERROR_RESPONSES, 404: UNKNOWN},
+            responses={**ERROR_RESPONSES, 404: READ_404},
             summary="A turntable's progress: frames done of frames")
 async def turntable_get(turntable_id: str, svc: ServiceDep, found: TurntablesDep,
                         shared: LanesDep) -> TurntableStatus:
@@ -130,7 +131,7 @@ async def turntable_get(turntable_id: str, svc: ServiceDep, found: TurntablesDep
 async def turntable_result(turntable_id: str, svc: ServiceDep, found: TurntablesDep,
                            shared: LanesDep) -> Response:
     entry = await current(svc, found, turntable_id, shared)
-    if entry["state"] in ("failed", "cancelled") and entry["failure"] is not None:
+    if entry["state"] == "failed" and entry["failure"] is not None:
         raise StoredFailure(entry["failure"])  # its own public status and reason
     data = await found.result(turntable_id) if entry["state"] == "done" else None
     if data is None and entry["state"] == "done":

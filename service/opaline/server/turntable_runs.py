@@ -25,7 +25,7 @@ from opaline.server.errors import UnknownTurntable
 from opaline.server.queries import parse_body
 from opaline.server.service import Service
 from opaline.server.statestore import Record, StoreUnavailable
-from opaline.server.turntable_jobs import Job, Lost, Turntables
+from opaline.server.turntable_jobs import Job, Lost, StoredFailure, Turntables
 from opaline.workers.animation_task import ENCODE_LABEL, AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
@@ -150,10 +150,14 @@ def unknown_line(turntable_id: str) -> str:
 
 async def current(svc: Service, found: Turntables, turntable_id: str,
                   shared: asyncio.Semaphore) -> dict[str, Any]:
-    """The job's record as it stands, after taking it over if it was orphaned."""
+    """The job's record as it stands, after taking it over if it was orphaned. A cancelled
+    job is gone for reads (404 ``cancelled``): a successful DELETE is not followed by a 2xx
+    GET."""
     record = await found.read(turntable_id)
     if record is None:
         raise UnknownTurntable(unknown_line(turntable_id))
+    if record.value["state"] == "cancelled":
+        raise StoredFailure(record.value["failure"])
     if found.orphaned(record):
         record = await adopt(svc, found, record, shared)
     return record.value
