@@ -77,6 +77,24 @@ def test_over_limit_uploads(client):
     assert client.get(f"/v1/render?preset=sphere&{SMALL}").status_code == 200
 
 
+@pytest.mark.gl
+def test_a_reupload_whose_check_cannot_run_keeps_the_stored_copy(backend, tmp_path):
+    """A mesh is the store's only once its check passed, and an upload whose check never ran
+    (here refused at once: 422 too_slow under a tiny deadline) leaves the store as it was.
+    Before, the refused re-upload discarded the copy already stored: its id answered 404."""
+    data = mesh_bytes("ply")
+    common = {"gl_backend": backend, "warmup": False, "calibrate": False, "workers": 1,
+              "mesh_store_dir": tmp_path}
+    with TestClient(create_app(Settings(**common))) as client:
+        mesh_id = client.post("/v1/meshes", content=data).json()["id"]
+        with TestClient(create_app(Settings(**common, deadline_s=0.05))) as hurried:
+            refused = hurried.post("/v1/meshes", content=data)
+            assert refused.status_code == 422 and refused.json()["error"] == "too_slow"
+        assert sorted(p.name for p in tmp_path.iterdir()) == [f"{mesh_id}.mesh"]
+        image = client.get(f"/v1/render?preset=sphere&mesh={mesh_id}&{SMALL}")
+        assert image.status_code == 200, image.text
+
+
 def _many_triangles() -> bytes:
     import trimesh
 

@@ -1,9 +1,9 @@
 """POST /v1/meshes: a user's mesh file in, its id out, checked by a render worker.
 
-The HTTP process stores and hashes the bytes (``meshstore``); a worker parses
-and validates them (``workers.mesh_tasks``), so the answer is 201 with the
-mesh's summary, or 422 ``invalid_mesh`` saying what is wrong with the file
-(which is then not kept; the body's schema, any binary, cannot express what a
+The HTTP process spools and hashes the bytes; a worker parses and validates
+them (``workers.mesh_tasks``), and only then does the store (``meshstore``) keep
+them, so the answer is 201 with the mesh's summary, or 422 ``invalid_mesh``
+saying what is wrong with the file (which is then not kept; the body's schema, any binary, cannot express what a
 mesh is), or 413 for a file over ``OPALINE_MESH_MAX_BYTES``. Renders name the
 id as ``mesh=<id>``; ``MeshStore.preset`` turns that into the preset the worker
 draws.
@@ -19,7 +19,7 @@ from pydantic import BaseModel, Field
 
 from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, Problem
-from opaline.server.mesh_upload import receive_mesh
+from opaline.server.mesh_upload import spooled_mesh
 from opaline.server.meshstore import InvalidMesh
 from opaline.server.render_routes import client_gone
 from opaline.workers.errors import InvalidInput
@@ -54,18 +54,17 @@ MESH_RESPONSES: dict[int | str, dict[str, Any]] = {
                                                          "format": "binary"}}}}})
 async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     store = svc.meshes
-    mesh_id = await receive_mesh(request, store)  # streamed to disk, never whole in memory
     max_triangles = svc.settings.mesh_max_triangles
-    task = MeshCheckTask(str(store.path_of(mesh_id)), max_triangles)
-    try:
-        summary = await svc.pool.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
-                                        timeout=svc.wait_s, gone=client_gone(request))
-    except InvalidInput as exc:
-        store.discard(mesh_id)
-        raise InvalidMesh(str(exc)) from None
-    except BaseException:
-        # Not checked (killed, refused, waited out, the client gone): never kept, so no
-        # render can parse it unchecked.
-        store.discard(mesh_id)
-        raise
+    # Streamed to disk, never whole in memory, and checked where it was spooled: the store
+    # holds it only once the check passed, so no render parses it unchecked, and a check
+    # that fails or never ran (killed, refused, waited out, the client gone) leaves the
+    # store as it was (a copy of the same bytes stored earlier stays).
+    async with spooled_mesh(request, store) as (spool, mesh_id):
+        task = MeshCheckTask(str(spool), max_triangles)
+        try:
+            summary = await svc.pool.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
+                                            timeout=svc.wait_s, gone=client_gone(request))
+        except InvalidInput as exc:
+            raise InvalidMesh(str(exc)) from None
+        store.put_file(spool, mesh_id)
     return MeshInfo(id=mesh_id, **json.loads(summary))

@@ -25,7 +25,7 @@ from opaline.server.errors import UnknownTurntable
 from opaline.server.queries import parse_body
 from opaline.server.service import Service
 from opaline.server.statestore import Record, StoreUnavailable
-from opaline.server.turntable_jobs import Job, Lost, StoredFailure, Turntables
+from opaline.server.turntable_jobs import CANCELLED, Job, Lost, StoredFailure, Turntables
 from opaline.workers.animation_task import ENCODE_LABEL, AnimationTask
 from opaline.workers.errors import DeadlineExceeded, Overloaded, TooSlow
 from opaline.workers.tasks import ImageTask
@@ -157,7 +157,7 @@ async def current(svc: Service, found: Turntables, turntable_id: str,
     if record is None:
         raise UnknownTurntable(unknown_line(turntable_id))
     if record.value["state"] == "cancelled":
-        raise StoredFailure(record.value["failure"])
+        raise StoredFailure(CANCELLED)  # not the record's: one written before 404 said 409
     if found.orphaned(record):
         record = await adopt(svc, found, record, shared)
     return record.value
