@@ -9,7 +9,7 @@ again and again, so every variant and the floor see the same load:
 - ``key``: the preset's own lights (its key light), standard and draft;
 - ``env``: ``environment=studio`` read from the map by lobe sampling
   (gl/environment_light.py), standard and draft at their tiers' ``environment_samples``;
-- standard with ``environment_samples`` 1, 2, 8 beside the tier's 4: a straight line
+- standard with ``environment_samples`` 1, 2, 8 beside the tier's own: a straight line
   through the four splits the render into a part per lobe sample and a fixed part;
 - on the sphere and cd-rom, standard at 8 wavelengths (the tier's 16 halved), key
   light and environment: how much of a lobe sample is the spectral BRDF it evaluates;
@@ -33,6 +33,7 @@ import statistics
 import sys
 import time
 
+from opaline.model.tiers import TIERS
 from report import save  # bench/report.py: run from bench/, it is on the path
 from speed import FLOOR, SIZE, Child
 
@@ -40,9 +41,9 @@ PRESETS = ("sphere", "nacre-film", "oil-film", "soap-bubble", "cd-rom")
 ENVIRONMENT = "studio"
 TARGETS = {"standard_over_key": 1.5, "draft_over_floor": 3.0}
 AIM = 0.2  # the margin aimed for: 20 % inside each target
-SWEEP = (1, 2, 8)  # environment_samples beside the standard tier's own (4)
-STANDARD_SAMPLES = 4  # the standard tier's environment_samples
-COMPARE_K = 16  # the standard tier's environment_lights
+SWEEP = (1, 2, 8)  # environment_samples beside the standard tier's own
+STANDARD_SAMPLES = TIERS["standard"].environment_samples
+COMPARE_K = TIERS["standard"].environment_lights
 WAVELENGTH_PRESETS = ("sphere", "cd-rom")
 
 
