@@ -26,6 +26,7 @@ import numpy as np
 from opaline.scene import meshlimits
 from opaline.scene import tangents as tangent_fields
 from opaline.scene.mesh import Mesh, make_mesh
+from opaline.scene.parse_memory import parse_ceiling, parse_headroom
 
 if TYPE_CHECKING:
     import trimesh
@@ -79,7 +80,7 @@ def _parse(data: bytes, fmt: str) -> trimesh.Trimesh:
 
     try:
         loaded = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh", process=False)
-    except MeshError:
+    except (MeshError, MemoryError):  # MemoryError: the parse ceiling, answered by the loader
         raise
     except Exception as exc:  # each parser fails in its own way on bad bytes
         raise MeshError(f"malformed or truncated {fmt.upper()} file: "
@@ -179,7 +180,13 @@ def load_mesh_file(path: str | Path, field: str = "auto",
         data = path.read_bytes()
     except OSError as exc:
         raise MeshError(f"cannot read mesh {path.name}: {exc.strerror or exc}") from None
-    found = parse_mesh(data, path.suffix, field, axis, max_triangles)
+    try:
+        with parse_ceiling():
+            found = parse_mesh(data, path.suffix, field, axis, max_triangles)
+    except MemoryError:
+        headroom = (parse_headroom() or 0) >> 20
+        raise MeshError(f"mesh {path.name} needs more than {headroom} MB to read, over this "
+                        "service's limit; send fewer triangles, or as GLB or binary PLY") from None
     _loaded[key] = found
     while len(_loaded) > CACHED_MESHES:
         _loaded.popitem(last=False)

@@ -94,6 +94,8 @@ def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     if lp_threads:
         os.environ["LP_NUM_THREADS"] = str(lp_threads)  # llvmpipe reads it at context creation
+    from opaline.scene.parse_memory import limit_parse_memory
+    limit_parse_memory()  # a mesh parse here has a hard memory ceiling (422 past it)
     try:
         renderer = factory()
         gl = getattr(renderer, "gl", None)

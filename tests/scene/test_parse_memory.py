@@ -1,0 +1,58 @@
+"""A mesh parse under a hard memory ceiling (RLIMIT_AS for its span): past the headroom
+the file is refused as a MeshError (422), the process lives on, and the limit is put back."""
+
+from __future__ import annotations
+
+import resource
+import sys
+
+import numpy as np
+import pytest
+
+from opaline.scene import meshfile
+from opaline.scene.meshfile import MeshError, load_mesh_file
+from opaline.scene.parse_memory import PARSE_HEADROOM_BYTES, limit_parse_memory, parse_ceiling
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS, /proc")
+
+
+@pytest.fixture
+def big_ply(tmp_path):
+    import trimesh
+
+    path = tmp_path / "sphere.ply"
+    path.write_bytes(trimesh.creation.icosphere(subdivisions=7).export(file_type="ply"))
+    return path  # 327 680 triangles, ~6 MB: its parse grows the address space ~70 MB
+
+
+@pytest.fixture
+def headroom():
+    before = resource.getrlimit(resource.RLIMIT_AS)
+    yield limit_parse_memory
+    limit_parse_memory(None)
+    meshfile._loaded.clear()
+    assert resource.getrlimit(resource.RLIMIT_AS) == before  # put back
+
+
+def test_a_parse_past_its_headroom_is_refused_and_the_limit_put_back(big_ply, headroom):
+    headroom(16 << 20)
+    with pytest.raises(MeshError, match="needs more than 16 MB to read"):
+        load_mesh_file(big_ply)
+    np.ones(64 << 20, dtype=np.uint8)  # outside the parse, 64 MB are had again
+    headroom(PARSE_HEADROOM_BYTES)  # the workers' default reads it
+    mesh, summary = load_mesh_file(big_ply)
+    assert summary["triangles"] == 327_680
+
+
+def test_the_ceiling_holds_inside_and_only_inside(headroom):
+    headroom(32 << 20)
+    with parse_ceiling():
+        with pytest.raises(MemoryError):
+            np.ones(256 << 20, dtype=np.uint8)
+    assert np.ones(256 << 20, dtype=np.uint8).size == 256 << 20
+
+
+def test_no_headroom_no_ceiling(headroom):
+    headroom(None)
+    with parse_ceiling():
+        assert np.ones(256 << 20, dtype=np.uint8).size == 256 << 20
