@@ -90,6 +90,7 @@ def test_a_reupload_whose_check_cannot_run_keeps_the_stored_copy(backend, tmp_pa
         with TestClient(create_app(Settings(**common, deadline_s=0.05))) as hurried:
             refused = hurried.post("/v1/meshes", content=data)
             assert refused.status_code == 422 and refused.json()["error"] == "too_slow"
+            assert refused.json()["detail"][0].startswith("checking this mesh file is")
         assert sorted(p.name for p in tmp_path.iterdir()) == [f"{mesh_id}.mesh"]
         image = client.get(f"/v1/render?preset=sphere&mesh={mesh_id}&{SMALL}")
         assert image.status_code == 200, image.text

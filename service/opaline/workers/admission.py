@@ -9,7 +9,10 @@ is pixels × samples, times the material's shading cost over its preset's own
 (``shading_index``: a grating's orders); ``growth`` is how much a wavelength
 costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
 ``extra`` is a task's own seconds (a mesh file's parse and its triangles).
-Until those arrive, and for labels the calibration did not cover, the slowest
+A task whose variant (``ImageTask.variant``: its program and scene) no worker has
+rendered yet also pays ``cold``, its label's first render over its second at
+calibration: the program's compile and the scene's build (0.1-0.3 s on llvmpipe,
+more than the render itself for a small image). Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
 cheaper than letting it hold a worker past its deadline.
@@ -19,8 +22,10 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Sequence
+from collections import OrderedDict
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from opaline.workers.errors import Overloaded, TooSlow, Unavailable
 
@@ -29,7 +34,9 @@ from opaline.workers.errors import Overloaded, TooSlow, Unavailable
 DEFAULT_PER_UNIT_S = 1.5e-6
 DEFAULT_PER_WAVELENGTH = 0.05
 DEFAULT_OVERHEAD_S = 0.02
+DEFAULT_COLD_S = 0.5  # a surface program's compile on llvmpipe, 0.1-0.3 s, and more
 SAFETY = 1.5
+WARM_VARIANTS = 64  # as many as a worker keeps compiled by default (worker_programs)
 # A mesh check (workers.mesh_tasks) is priced by its file's size: trimesh's import on a
 # worker's first check, then about 0.14 s/MB for the slowest format (ASCII PLY), and at
 # most its own time limit, after which the worker is killed.
@@ -55,8 +62,33 @@ class CostModel:
     overhead_s: float = DEFAULT_OVERHEAD_S
     calibration_wavelengths: int = 16
     labels: dict[str, Coefficients] = field(default_factory=dict)
+    cold: dict[str, float] = field(default_factory=dict)
     calibrated: bool = False
+    _warm: OrderedDict[Hashable, None] = field(default_factory=OrderedDict, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+
+    def predict_task(self, task: Any) -> float:
+        """``predict`` of the task's units, and its variant's first-render cost if no
+        worker has rendered that variant lately."""
+        units = task.units()
+        variant = getattr(task, "variant", None)
+        if variant is None:
+            return self.predict(*units)
+        with self._lock:
+            cold = variant() not in self._warm
+            cold_s = self.cold.get(units[0], max(self.cold.values(), default=DEFAULT_COLD_S))
+        return self.predict(*units) + (SAFETY * cold_s if cold else 0.0)
+
+    def warmed(self, task: Any) -> None:
+        """A worker rendered ``task``: its variant is compiled (the newest few are kept)."""
+        variant = getattr(task, "variant", None)
+        if variant is None:
+            return
+        with self._lock:
+            self._warm[variant()] = None
+            self._warm.move_to_end(variant())
+            while len(self._warm) > WARM_VARIANTS:
+                self._warm.popitem(last=False)
 
     def predict(self, label: str, units: float, wavelengths: int, extra_s: float = 0.0) -> float:
         """Predicted seconds for a task (safety factor included)."""
@@ -86,8 +118,10 @@ class CostModel:
             per_unit = max(plain - overhead, 0.2 * plain) / units
             extra = max(spectral - overhead, 0.2 * spectral) / (per_unit * units) - 1.0
             labels[label] = Coefficients(per_unit, max(extra, 0.0) / wavelengths)
+        cold = {label: max(0.0, float(s)) for label, s in data.get("cold_s", {}).items()}
         with self._lock:
             self.overhead_s, self.labels, self.calibrated = overhead, labels, True
+            self.cold = cold
             self.calibration_wavelengths = int(wavelengths)
 
     def describe(self) -> dict[str, object]:
@@ -119,18 +153,25 @@ def check_cost_s(size_bytes: float) -> float:
     return min(CHECK_TIME_LIMIT_S, SAFETY * (CHECK_BASE_S + CHECK_S_PER_BYTE * size_bytes))
 
 
+RENDER_ADVICE = "lower width, height, samples or wavelengths (or choose a lower quality)"
+CHECK_ADVICE = ("send a smaller file (fewer triangles; GLB or binary PLY read fastest), or "
+                "ask the operator for a longer OPALINE_DEADLINE_S")
+
+
 def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequence[float],
-          queue_size: int, deadline_s: float) -> Exception | None:
+          queue_size: int, deadline_s: float, label: str = "") -> Exception | None:
     """Why a job predicted to take ``predicted`` seconds cannot be taken now, or None.
 
     ``running``: the predicted seconds left of each job being rendered; ``queued``:
-    the predictions of the jobs waiting. The work ahead is shared by the workers."""
+    the predictions of the jobs waiting. The work ahead is shared by the workers. ``label``:
+    the job's, so that a refusal's advice fits it (a mesh check is no render)."""
     if not workers:
         return Unavailable("no render worker has a GL context (the server log says why)")
     if predicted > deadline_s:
-        return TooSlow(f"this request is predicted to take {predicted:.1f} s, over the "
-                       f"{deadline_s:g} s limit: lower width, height, samples or wavelengths "
-                       "(or choose a lower quality)")
+        what, advice = (("checking this mesh file", CHECK_ADVICE) if label == CHECK_LABEL
+                        else ("this request", RENDER_ADVICE))
+        return TooSlow(f"{what} is predicted to take {predicted:.1f} s, over the "
+                       f"{deadline_s:g} s limit: {advice}")
     backlog = (sum(running) + sum(queued)) / workers
     if len(queued) >= queue_size or backlog + predicted > deadline_s:
         return Overloaded(f"{len(queued)} jobs are waiting, about {backlog:.1f} s of work",

@@ -115,7 +115,7 @@ class WorkerPool:
                 found.waiters += 1
                 return found
             job = Job(next(self._ids), key, task, label or task.label,
-                      time.monotonic() + self.deadline_s, self.cost.predict(*task.units()))
+                      time.monotonic() + self.deadline_s, self.cost.predict_task(task))
             data = self.cache.get(key) if self.cache is not None else None
             if data is not None:  # rendered after the caller looked
                 job.future.set_result(data)
@@ -131,7 +131,7 @@ class WorkerPool:
         # A worker being replaced counts: its job waits the second a new process takes.
         workers = sum(slot.state in ("ready", "busy", "starting") for slot in self.slots)
         refusal = admit(job.predicted, workers, running, [j.predicted for j in self._queue],
-                        self.queue_size, self.deadline_s)
+                        self.queue_size, self.deadline_s, job.label)
         if refusal is not None:
             self.counters["refused_too_slow" if isinstance(refusal, TooSlow)
                           else "refused_queue"] += 1
@@ -191,6 +191,7 @@ class WorkerPool:
                 self.cost.calibrate(reply.data)
             elif self.cache is not None:
                 self.cache.put(job.key, reply.data)
+            self.cost.warmed(job.task)
             if self.on_rendered is not None:
                 self.on_rendered(job.label, reply.seconds)
             self._settle(job, result=reply.data)

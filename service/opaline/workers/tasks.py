@@ -63,6 +63,18 @@ class ImageTask:
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         return produce(self.prepared, renderer, should_stop)
 
+    def variant(self) -> tuple[object, ...]:
+        """What selects the program a worker compiles and the scene it builds: the job's
+        categorical fields. Admission prices a variant no worker has rendered yet with its
+        compile (``CostModel.predict_task``); a define a numeric field switches is missed."""
+        job = self.prepared.job
+        material = tuple(sorted((k, v) for k, v in job.material.model_dump().items()
+                                if isinstance(v, (str, bool)) or k == "grating_orders"))
+        return (self.prepared.preset.name, self.prepared.preset.geometry.args.get("path"),
+                job.wavelengths, job.samples, job.aa, job.tonemap, job.transparent,
+                job.environment, job.environment_lights, job.environment_samples,
+                job.environment_background, material)
+
     def units(self) -> tuple[str, float, int, float]:
         job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
@@ -116,35 +128,44 @@ CALIBRATION_WAVELENGTHS = 16
 @dataclass(frozen=True)
 class CalibrateTask:
     """Time each preset at 0 and ``CALIBRATION_WAVELENGTHS`` wavelengths (after a warm-up
-    render of the same variant, so compile time is not counted); answers JSON."""
+    render of the same variant, so compile time is not counted), and what that first render
+    cost more (``cold_s``: the compile, the scene); answers JSON."""
 
     label: str = "calibration"
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         timings: dict[str, list[float]] = {}
+        cold: dict[str, float] = {}
         for name, preset in all_presets().items():
-            timings[name] = [self._time(renderer, preset, w, should_stop)
-                             for w in (0, CALIBRATION_WAVELENGTHS)]
+            both = [self._time(renderer, preset, w, should_stop)
+                    for w in (0, CALIBRATION_WAVELENGTHS)]
+            timings[name] = [warm for _, warm in both]
+            cold[name] = max(first - warm for first, warm in both)
         tiny = RenderRequest(width=16, height=16, samples=1, wavelengths=0, quality="draft")
-        overhead = self._time_job(renderer, tiny, should_stop)
+        overhead = self._time_job(renderer, tiny, should_stop)[1]
         units = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
         return json.dumps({"overhead_s": overhead, "units": units,
-                           "wavelengths": CALIBRATION_WAVELENGTHS, "timings": timings}).encode()
+                           "wavelengths": CALIBRATION_WAVELENGTHS, "timings": timings,
+                           "cold_s": cold}).encode()
 
     def _time(self, renderer: Any, preset: Preset, wavelengths: int, should_stop: StopCheck
-              ) -> float:
+              ) -> tuple[float, float]:
         request = RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
                                 height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
                                 wavelengths=wavelengths)
         return self._time_job(renderer, request, should_stop)
 
     @staticmethod
-    def _time_job(renderer: Any, request: RenderRequest, should_stop: StopCheck) -> float:
+    def _time_job(renderer: Any, request: RenderRequest, should_stop: StopCheck
+                  ) -> tuple[float, float]:
+        """Seconds of the variant's first render (its compile, its scene) and of the next."""
         task = ImageTask(prepare(request, PRIVATE))
-        task.run(renderer, should_stop)  # compiles the variant
-        start = time.perf_counter()
-        task.run(renderer, should_stop)
-        return time.perf_counter() - start
+        seconds = []
+        for _ in range(2):
+            start = time.perf_counter()
+            task.run(renderer, should_stop)
+            seconds.append(time.perf_counter() - start)
+        return seconds[0], seconds[1]
 
     def units(self) -> tuple[str, float, int]:
         """Four renders per preset (a warm-up and a timing at each of two wavelength
