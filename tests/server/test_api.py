@@ -416,6 +416,8 @@ def test_full_queue_is_503_with_retry_after(backend, tmp_path):
 def test_request_past_deadline_is_503(backend, tmp_path):
     """A request that waited in the queue past deadline_s is dropped and answers 503."""
     with make_client(backend, deadline_s=0.3) as client:
+        # The variant rendered once (mu_f is a uniform): admission no longer adds its compile.
+        assert client.get(f"/v1/render?{SMALL}&mu_f=1.5").status_code == 200
         gate = occupy(client, tmp_path)
         answers: list = []
         asker = threading.Thread(
@@ -426,7 +428,7 @@ def test_request_past_deadline_is_503(backend, tmp_path):
         asker.join(WAIT)
         assert answers[0].status_code == 503 and "Retry-After" in answers[0].headers
         assert sample(client, "opaline_rejected_requests_total", {"reason": "deadline"}) == 1
-        assert sample(client, "opaline_render_seconds_count", {"preset": "sphere"}) == 0
+        assert sample(client, "opaline_render_seconds_count", {"preset": "sphere"}) == 1
 
 
 def test_identical_concurrent_requests_render_once(backend, tmp_path):

@@ -97,11 +97,13 @@ class RenderFields(MaterialFields, SceneFields):
     )
     # quality="auto" (model/auto.py): the cheapest measured setting within these budgets.
     max_flip: Annotated[float, Field(gt=0.0, le=1.0)] | None = Field(
-        None, description="With quality 'auto': largest FLIP against a converged render, (0, 1]."
+        None, description="With quality 'auto' (or none): largest FLIP against a converged render, "
+        "(0, 1]; with a named tier, 422 budget_with_tier."
     )
     max_delta_e: Annotated[float, Field(gt=0.0, le=100.0)] | None = Field(
         None,
-        description="With quality 'auto': largest CIEDE2000 (95th percentile) against a converged render, (0, 100].",
+        description="With quality 'auto' (or none): largest CIEDE2000 (95th percentile) against a "
+        "converged render, (0, 100]; with a named tier, 422 budget_with_tier.",
     )
     samples: Annotated[int, Field(ge=1, le=1024)] | None = Field(
         None, description="Samples per pixel, 1 … 1024 (default: the tier's)."

@@ -11,8 +11,8 @@ costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
 ``extra`` is a task's own seconds (a mesh file's parse and its triangles).
 A task whose variant (``ImageTask.variant``: its program and scene) no worker has
 rendered yet also pays ``cold``, its label's first render over its second at
-calibration: the program's compile and the scene's build (0.1-0.3 s on llvmpipe,
-more than the render itself for a small image). Until those arrive, and for labels the calibration did not cover, the slowest
+calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,
+up to 0.9 s where an environment map is loaded; more than a small image's render). Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
 cheaper than letting it hold a worker past its deadline.
@@ -34,7 +34,10 @@ from opaline.workers.errors import Overloaded, TooSlow, Unavailable
 DEFAULT_PER_UNIT_S = 1.5e-6
 DEFAULT_PER_WAVELENGTH = 0.05
 DEFAULT_OVERHEAD_S = 0.02
-DEFAULT_COLD_S = 0.5  # a surface program's compile on llvmpipe, 0.1-0.3 s, and more
+# A variant's first render over its second at calibration (192², llvmpipe): 0.01-0.04 s
+# for most presets, 0.13-0.93 s where the preset loads an environment map. Before the
+# calibration, a typical compile: more would refuse every new variant under a short deadline.
+DEFAULT_COLD_S = 0.1
 SAFETY = 1.5
 WARM_VARIANTS = 64  # as many as a worker keeps compiled by default (worker_programs)
 # A mesh check (workers.mesh_tasks) is priced by its file's size: trimesh's import on a
