@@ -12,7 +12,8 @@ costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
 A task whose variant (``ImageTask.variant``: its program and scene) no worker has
 rendered yet also pays ``cold``, its label's first render over its second at
 calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,
-up to 0.9 s where an environment map is loaded; more than a small image's render). Until those arrive, and for labels the calibration did not cover, the slowest
+up to 0.9 s where an environment map is loaded; more than a small image's render).
+Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
 cheaper than letting it hold a worker past its deadline.
