@@ -112,6 +112,9 @@ HOSTILE = {
     "gltf-200000-instances": (gltf_instanced, "limit of 1000"),
     "ascii-ply-1.5M-undeclared-lines": (lambda: ply_with_lines(1_500_000),
                                         "limit of two a row"),
+    "ascii-ply-30M-undeclared-lines": (lambda: ply_with_lines(30_000_000),
+                                       "limit of two a row"),
+    "gltf-5000-nodes-nested": (gltf_nested, "limit of 1000"),
     "ascii-stl-200000-solids": (stl_solids, "limit of"),
     "ascii-stl-300-solids": (lambda: stl_solids(300), "limit of 256 solids"),
     "gltf-json-nested-100000-deep": (

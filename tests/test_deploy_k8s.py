@@ -155,7 +155,7 @@ def test_timeouts_cover_the_longest_wait():
     """Nobody gives up before the service does: the pod's grace period (after the preStop
     pause) and nginx's read and cache-lock timeouts are at least the service's wait."""
     deployment = find("Deployment", "opaline")
-    wait = Service(settings_of(deployment), None, None, None, None).wait_s  # type: ignore[arg-type]
+    wait = Service(settings_of(deployment), None, None, None, None, None).wait_s  # type: ignore[arg-type]
     pause = container(deployment)["lifecycle"]["preStop"]["sleep"]["seconds"]
     assert deployment["spec"]["template"]["spec"]["terminationGracePeriodSeconds"] >= wait + pause
     template = TEMPLATE.read_text()

@@ -95,4 +95,6 @@ def memory_budget_bytes(settings: Settings) -> int:
     every cache is an LRU under its budget, and a worker past its limit is recycled."""
     mib = 1024 * 1024
     per_worker = settings.worker_max_rss_mb * mib + FRAME_BYTES
-    return HTTP_BASE_BYTES + settings.cache_bytes + 2 * FRAME_BYTES + settings.workers * per_worker
+    check_worker = settings.worker_max_rss_mb * mib  # the mesh-check lane's: no GL, no frames
+    return (HTTP_BASE_BYTES + settings.cache_bytes + 2 * FRAME_BYTES
+            + settings.workers * per_worker + check_worker)

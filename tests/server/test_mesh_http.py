@@ -168,29 +168,64 @@ def _peak_rss_mb(pid: int) -> float:
 
 
 @pytest.mark.gl
-def test_hostile_uploads_get_422_at_once_and_the_worker_stays_small(backend, tmp_path, capsys):
-    """Issue 24's files, uploaded under the default limits: each 422 naming its limit within
-    2 s, the worker never replaced and its peak RSS barely moved (before, the 316-byte GLB
-    alone took it to 4 GB), the service ready and rendering."""
+def test_hostile_uploads_get_422_at_once_while_a_bystander_is_served(backend, tmp_path, capsys):
+    """Issue 24's files, uploaded to a real server on loopback under the default limits: each
+    422 naming its limit within 2 s, the check lane's worker never replaced and its peak RSS
+    barely moved (before, the 316-byte GLB alone took a render worker to 4 GB); meanwhile
+    another client polls /readyz and renders, and every one of its answers is 200 (checks
+    have their own lane: before, a check priced at 10 s made its renders 503). The 16 KB GLB with two 8000² textures
+    is a mesh: 201 at once, its images never decoded, drawn at once."""
+    import threading
     import time
 
-    from hostile_meshes import HOSTILE
+    import httpx
 
-    settings = Settings(gl_backend=backend, warmup=False, calibrate=False, workers=1,
-                        mesh_store_dir=tmp_path)
-    with TestClient(create_app(settings)) as client:
-        pid = client.get("/readyz").json()["workers"][0]["pid"]
+    from hostile_meshes import HOSTILE, glb_with_textures
+    from opaline.server.localserver import LocalServer
+
+    env = {"OPALINE_GL_BACKEND": backend, "OPALINE_WARMUP": "0", "OPALINE_CALIBRATE": "0",
+           "OPALINE_MESH_STORE_DIR": str(tmp_path)}
+    stop, ready, bystander = threading.Event(), [], []
+
+    def bystand(base: str) -> None:
+        with httpx.Client(base_url=base, trust_env=False, timeout=30) as other:
+            while not stop.is_set():
+                probe = other.get("/readyz")
+                ready.append(probe.status_code if probe.status_code == 200 else probe.text)
+                mu_f = 2 + len(bystander) / 64  # a new image each time: a render
+                bystander.append(other.get(f"/v1/render?{SMALL}&mu_f={mu_f}").status_code)
+                time.sleep(0.05)
+
+    with (LocalServer(workers=1, env=env) as server,
+          httpx.Client(base_url=server.base, trust_env=False, timeout=30) as client):
+        pid = client.get("/readyz").json()["checks"][0]["pid"]  # the check lane's worker
         before = _peak_rss_mb(pid)
-        for name, (build, words) in sorted(HOSTILE.items()):
+        watcher = threading.Thread(target=bystand, args=(server.base,))
+        watcher.start()
+        try:
+            for name, (build, words) in sorted(HOSTILE.items()):
+                body = build()
+                start = time.monotonic()
+                answer = client.post("/v1/meshes", content=body)
+                seconds = time.monotonic() - start
+                assert answer.status_code == 422, (name, answer.text)
+                assert words in answer.json()["detail"][0] and seconds < 2.0, (name, seconds)
             start = time.monotonic()
-            answer = client.post("/v1/meshes", content=build())
-            seconds = time.monotonic() - start
-            assert answer.status_code == 422, (name, answer.text)
-            assert words in answer.json()["detail"][0] and seconds < 2.0, (name, seconds)
-            assert client.get("/readyz").json()["workers"][0]["pid"] == pid  # never killed
+            textured = client.post("/v1/meshes", content=glb_with_textures())
+            assert textured.status_code == 201 and time.monotonic() - start < 2.0, textured.text
+            start = time.monotonic()  # a render worker's first mesh: it imports trimesh
+            drawn = client.get(f"/v1/render?mesh={textured.json()['id']}&{SMALL}")
+            assert drawn.status_code == 200 and time.monotonic() - start < 5.0  # was 18-22 s
+        finally:
+            stop.set()
+            watcher.join(30)
+        assert client.get("/readyz").json()["checks"][0]["pid"] == pid  # never killed
         grown = _peak_rss_mb(pid) - before
-        assert client.get(f"/v1/render?preset=sphere&{SMALL}").status_code == 200
-    assert not list(tmp_path.iterdir())  # none of them kept
+    assert ready and set(ready) == {200}, ready
+    assert bystander and set(bystander) == {200}, bystander
+    assert sorted(p.name for p in tmp_path.iterdir()) == [textured.json()["id"] + ".mesh"]
     with capsys.disabled():
-        print(f"\n  hostile uploads: worker peak RSS {before:.0f} MB, +{grown:.0f} MB")
+        print(f"\n  hostile uploads: {len(HOSTILE)} files refused, check worker peak RSS "
+              f"{before:.0f} MB, +{grown:.0f} MB; bystander {len(bystander)} renders and "
+              f"{len(ready)} /readyz, all 200")
     assert grown < 128

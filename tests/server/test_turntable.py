@@ -133,7 +133,7 @@ class FullQueue:
 
 
 def test_a_frame_waits_out_a_full_queue_until_the_turntable_deadline():
-    svc = Service(Settings(), FullQueue(3), None, None, None)  # type: ignore[arg-type]
+    svc = Service(Settings(), FullQueue(3), None, None, None, None)  # type: ignore[arg-type]
 
     async def go(deadline_in: float) -> bytes:
         return await patiently(svc, "k", None, asyncio.get_running_loop().time() + deadline_in)

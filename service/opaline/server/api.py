@@ -33,6 +33,7 @@ from opaline.pipeline.prepare import prepare
 from opaline.server.access import Access
 from opaline.server.body_limit import BodyLimit
 from opaline.server.cache import ImageCache
+from opaline.server.check_lane import check_lane
 from opaline.server.connections import STATS as CONNECTION_STATS
 from opaline.server.deps import ServiceDep, SettingsDep
 from opaline.server.docs import SecurityHeaders, mount_docs
@@ -112,7 +113,8 @@ async def readyz(svc: ServiceDep, response: Response) -> Readiness:
     return Readiness(ready=svc.pool.ready, backend=(ready or {}).get("backend"),
                      renderer=(ready or {}).get("renderer"), queue_depth=svc.pool.depth(),
                      calibrated=svc.pool.cost.calibrated,
-                     memory_budget_bytes=memory_budget_bytes(svc.settings), workers=workers)
+                     memory_budget_bytes=memory_budget_bytes(svc.settings), workers=workers,
+                     checks=svc.checks.status())
 
 
 @router.get("/metrics", tags=["operations"], summary="Prometheus metrics",
@@ -143,12 +145,13 @@ def mount_web(app: FastAPI, web_dir: Path = WEB_DIR) -> None:
 async def lifespan(app: FastAPI) -> AsyncIterator[None]:
     all_presets()  # an invalid preset stops the start-up, naming the file and field
     scratch.sweep(*scratch.WORKER_KINDS)  # a killed run's (its mesh folder: the store's)
-    await asyncio.to_thread(app.state.pool.start)
+    await asyncio.gather(*(asyncio.to_thread(p.start) for p in (app.state.pool, app.state.checks)))
     try:
         yield
     finally:
         await app.state.turntables.stop()  # before the workers: stopped, not failed
-        await asyncio.to_thread(app.state.pool.stop)
+        await asyncio.gather(*(asyncio.to_thread(p.stop) for p in (app.state.pool,
+                                                                   app.state.checks)))
         # Here, not at exit: uvicorn re-raises SIGTERM/SIGINT, so atexit never runs.
         app.state.meshes.close()
         scratch.sweep(*scratch.WORKER_KINDS)  # every worker gone: what a killed one left
@@ -224,6 +227,7 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     app.state.cache, app.state.metrics = cache, metrics
     state = open_state(settings)
     app.state.meshes = MeshStore(settings, state)
+    app.state.checks = check_lane(settings)
     app.state.turntables = Turntables(state, settings)
     app.state.turntable_lanes = asyncio.Semaphore(settings.workers)
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes,

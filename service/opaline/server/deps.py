@@ -38,7 +38,7 @@ async def get_service(request: Request) -> Service:
     """The routes' view of the app."""
     state = request.app.state
     return Service(await app_settings(request), state.pool, state.cache, state.metrics,
-                   state.meshes)
+                   state.meshes, state.checks)
 
 
 async def turntables(request: Request) -> Turntables:

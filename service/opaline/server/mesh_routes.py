@@ -1,7 +1,8 @@
 """POST /v1/meshes: a user's mesh file in, its id out, checked by a render worker.
 
-The HTTP process spools and hashes the bytes; a worker parses and validates
-them (``workers.mesh_tasks``), and only then does the store (``meshstore``) keep
+The HTTP process spools and hashes the bytes; the check lane's worker
+(``check_lane``, never in front of renders) parses and validates them
+(``workers.mesh_tasks``), and only then does the store (``meshstore``) keep
 them, so the answer is 201 with the mesh's summary, or 422 ``invalid_mesh``
 saying what is wrong with the file (which is then not kept; the body's schema, any binary, cannot express what a
 mesh is), or 413 for a file over ``OPALINE_MESH_MAX_BYTES``. Renders name the
@@ -62,8 +63,8 @@ async def meshes_post(request: Request, svc: ServiceDep) -> MeshInfo:
     async with spooled_mesh(request, store) as (spool, mesh_id):
         task = MeshCheckTask(str(spool), max_triangles)
         try:
-            summary = await svc.pool.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
-                                            timeout=svc.wait_s, gone=client_gone(request))
+            summary = await svc.checks.render(f"mesh-check:{mesh_id}:{max_triangles}", task,
+                                              timeout=svc.wait_s, gone=client_gone(request))
         except InvalidInput as exc:
             raise InvalidMesh(str(exc)) from None
         store.put_file(spool, mesh_id)

@@ -42,6 +42,10 @@ class Readiness(BaseModel):
     workers: list[dict[str, Any]] = Field(
         description="Each worker process: name, state (starting, ready, busy, failed, stopped), "
         "pid, renders, rss_bytes, restarts, its GL context's description, and the last error.")
+    checks: list[dict[str, Any]] = Field(
+        default_factory=list,
+        description="The mesh-check lane's worker processes (uploads are parsed there, never "
+        "in front of renders), as workers; a failed one fails uploads only, not readiness.")
 
 
 class TierInfo(BaseModel):

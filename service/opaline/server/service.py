@@ -1,5 +1,5 @@
-"""What the routes work with: the settings, the worker pool, the image cache, the metrics
-and the mesh store (``deps.get_service`` hands it to each route)."""
+"""What the routes work with: the settings, the worker pool, the image cache, the metrics,
+the mesh store and the mesh-check lane (``deps.get_service`` hands it to each route)."""
 
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ class Service:
     cache: ImageCache
     metrics: Metrics
     meshes: MeshStore
+    checks: WorkerPool  # the mesh-check lane (``check_lane``)
 
     @property
     def context(self) -> Context:

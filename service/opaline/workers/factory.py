@@ -23,3 +23,21 @@ class RendererFactory:
         budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
                                 target_bytes=self.target_bytes)
         return Renderer(self.backend, budgets=budgets, environments_dir=self.environments_dir)
+
+
+class ParserOnly:
+    """What a mesh-check worker holds instead of a renderer: no GL context (a check parses
+    a file and never draws), so the lane costs a Python process, not a context."""
+
+    gl = None
+
+    def release(self) -> None:
+        pass
+
+
+@dataclass(frozen=True)
+class ParserFactory:
+    """The recipe of the mesh-check lane's worker (``server/check_lane.py``)."""
+
+    def __call__(self) -> ParserOnly:
+        return ParserOnly()
