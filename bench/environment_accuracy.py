@@ -99,8 +99,9 @@ def table(rows: list[dict[str, Any]], size: int, samples: int) -> str:
              f"Reference: the reference tier, the map read unfiltered, {samples} lobe "
              "samples per pixel; `converged` is its FLIP against half as many. Command: "
              "`python bench/environment_accuracy.py`.", "",
-             "| case | environment | tier | method | ms | FLIP | ΔE00 mean | ΔE00 p95 | converged |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| case | environment | tier | method | ms | FLIP | lighting FLIP | ΔE00 mean | "
+             "ΔE00 p95 | converged |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['case']} | {r['environment']} | {r['tier']} | {r['method']} | "
                      f"{r['ms']:.0f} | {r['flip']:.4f} | {r['lighting_flip']:.4f} | "

@@ -182,8 +182,10 @@ def markdown(result: dict) -> str:
             if v["passes"] else f"MISSED by {-v['margin']:.0%}"
         lines.append(f"| {v['preset']} | {v['variant']} {v['unit']} | {v['figure']:.2f} | "
                      f"≤ {v['target']:g} | {v['margin']:+.0%} | {verdict} |")
-    lines += ["", "Standard at 1, 2, 4, 8 lobe samples, a straight line through them (ms):", "",
-              "| preset | per lobe sample | fixed | key light standard | samples' share at 4 |",
+    lines += ["", f"Standard at {sorted({*SWEEP, STANDARD_SAMPLES})} lobe samples, a straight line "
+              "through them (ms; nothing to fit where the environment is lights):", "",
+              f"| preset | per lobe sample | fixed | key light standard | samples' share at "
+              f"{STANDARD_SAMPLES} |",
               "|---|---|---|---|---|"]
     for p in result["per_sample"]:
         lines.append(f"| {p['preset']} | {p['ms_per_sample']:.2f} | {p['fixed_ms']:.1f} | "

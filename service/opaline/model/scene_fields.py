@@ -61,8 +61,9 @@ class SceneFields(BaseModel):
     environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
         None, description="Light the scene with an environment instead of the preset's lights: "
                           f"{BUILT_IN}, or an .hdr/.exr file of the environments folder; "
-                          f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: none on "
-                          f"the presets' own geometry, '{MESH_ENVIRONMENT}' on a user's mesh.",
+                          f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: the "
+                          "preset's (none on most; studio on soap-bubble and the films on "
+                          f"metals), '{MESH_ENVIRONMENT}' on a user's mesh.",
         examples=[*BUILTIN, NO_ENVIRONMENT])
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Turns the environment about the up axis, degrees (default 0).")

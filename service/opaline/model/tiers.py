@@ -84,7 +84,7 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
     ``high``'s. The table measured the material under converged light (the reference
     tier's), so the light must not add its own error: against the brute-force reference
     (bench/results/environment_accuracy.md) lobe sampling is within FLIP 0.05 from high's
-    64 samples on, 0.07-0.12 at standard's 6 and 0.12-0.18 at draft's 2."""
+    64 samples on (0.004-0.038), 0.016-0.11 at standard's 6 and 0.016-0.18 at draft's 2."""
     like = next((tier for tier in TIERS.values()
                  if tier.samples >= samples and tier.wavelengths >= wavelengths),
                 TIERS["reference"])
