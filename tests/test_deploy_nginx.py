@@ -4,8 +4,9 @@ Shows, with the figures printed (pytest -s): a miss on one replica is a hit for
 requests that the balancer routes to the other; 50 concurrent equal requests
 render once across both replicas; killing a replica mid-run loses no request
 the other can serve. The replicas share a real Redis (OPALINE_STATE_URL): a mesh
-uploaded through the proxy renders on both, a turntable answers from either, and one
-whose replica is killed mid-run is finished by the other. The mesh and turntable tests
+uploaded through the proxy renders on both, a turntable answers from either, one
+whose replica is killed mid-run is finished by the other, and with the store stopped
+only the state routes answer 503 (plain renders go on; nginx rests no replica). The mesh and turntable tests
 run again on one replica with the default embedded state (no OPALINE_STATE_URL, no
 Redis). Bounded: small images, about 45 s in all on 2 cores.
 """
@@ -303,6 +304,48 @@ def test_a_turntable_outlives_the_replica_running_it(store):
     print(f"\ntake-over: the replica running a turntable started through the proxy killed "
           f"after {at_kill} of 24 frames; {len(seen)} polls via the proxy all 200, the "
           f"survivor finished it ({again:.0f} frames)")
+
+
+def test_the_store_down_through_the_proxy_is_503_for_state_only_and_recovers():
+    """Redis stopped under two replicas behind nginx: an upload, a turntable start, a poll
+    and a result answer 503 store_unavailable with Retry-After, whichever replica nginx
+    picks; plain renders keep answering 200; once the store is back (empty: this one
+    keeps nothing on disk), an upload renders on both replicas and turntables start."""
+    need_nginx()
+    with LocalRedis() as redis:
+        env = {**REPLICA_ENV, "OPALINE_STATE_URL": redis.url, "OPALINE_STATE_TIMEOUT_S": "0.5"}
+        with (LocalServer(env=env) as a, LocalServer(env=env) as b,
+              LocalProxy([a.base, b.base]) as proxy,
+              httpx.Client(base_url=proxy.base, trust_env=False, timeout=30) as client):
+            body = {"preset": PRESET, "frames": 3, "width": 48, "height": 48,
+                    "quality": "draft", "mu_f": 4.4}
+            started = client.post("/v1/turntables", json=body)
+            assert started.status_code == 202, started.text
+            path = f"/v1/turntables/{started.json()['id']}"
+            poll_until_done([client], path)
+            redis.stop()
+            down = [client.post("/v1/meshes", content=mesh_bytes("ply")),
+                    client.post("/v1/turntables", json={**body, "frames": 4}),
+                    client.get(path), client.get(path + "/result")]
+            for answer in down:
+                assert answer.status_code == 503, (answer.request.url, answer.text)
+                assert answer.json()["error"] == "store_unavailable", answer.text
+                assert int(answer.headers["retry-after"]) >= 1
+            renders = [client.get(url(mu_f=5 + i / 10, width=48, height=48)).status_code
+                       for i in range(6)]
+            assert renders == [200] * 6
+            redis.start()
+            upload = client.post("/v1/meshes", content=mesh_bytes("ply"))
+            assert upload.status_code == 201, upload.text
+            mesh = [client.get(f"/v1/render?preset={PRESET}&mesh={upload.json()['id']}"
+                               f"&mu_f={3 + i / 7}&width=48&height=48&quality=draft")
+                    for i in range(4)]
+            assert [m.status_code for m in mesh] == [200] * 4
+            again = client.post("/v1/turntables", json={**body, "frames": 4})
+            assert again.status_code == 202, again.text
+    print(f"\nstore down: {[a.status_code for a in down]} for upload, turntable start, poll "
+          f"and result, each with Retry-After; plain renders {renders}; back: upload 201, "
+          f"its renders {[m.status_code for m in mesh]}, turntable 202")
 
 
 class VaryingUpstream(BaseHTTPRequestHandler):
