@@ -144,14 +144,6 @@ class MeshStore:
         finally:
             scratch.release(fd, tmp)
 
-    def discard(self, mesh_id: str) -> None:
-        """Forget a mesh the worker refused, so an invalid file never takes space."""
-        with self._lock:
-            if self._sizes.pop(mesh_id, None) is not None:
-                self.path_of(mesh_id).unlink(missing_ok=True)
-        if self.shared is not None:
-            self.shared.delete(f"mesh:{mesh_id}")
-
     def resolve(self, name: str) -> tuple[Path, str]:
         """The file and content digest a request's ``mesh`` names; UnknownMesh if none."""
         if MESH_ID.match(name):

@@ -88,9 +88,10 @@ class CostModel:
         variant = getattr(task, "variant", None)
         if variant is None:
             return
+        key = variant()
         with self._lock:
-            self._warm[variant()] = None
-            self._warm.move_to_end(variant())
+            self._warm[key] = None
+            self._warm.move_to_end(key)
             while len(self._warm) > WARM_VARIANTS:
                 self._warm.popitem(last=False)
 
