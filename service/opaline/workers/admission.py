@@ -78,8 +78,9 @@ class CostModel:
         variant = getattr(task, "variant", None)
         if variant is None:
             return self.predict(*units)
+        key = variant()  # outside the lock: it reads the whole material
         with self._lock:
-            cold = variant() not in self._warm
+            cold = key not in self._warm
             cold_s = self.cold.get(units[0], max(self.cold.values(), default=DEFAULT_COLD_S))
         return self.predict(*units) + (SAFETY * cold_s if cold else 0.0)
 
