@@ -1,11 +1,13 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS ENV_SAMPLES ENV_BRUTE
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE
 // Test harness for environment light: each pixel runs one case read from float
 // textures through lib/lobe_sampling.glsl and lib/environment_light.glsl, so the
 // samplers, the irradiance and the estimator can be held against their float64
 // twins case by case. u_mode: 0 sample_ashikhmin(a.xy), 1 sample_projected_disc(a.xy),
 // 2 env_sample_half(a.xyz): (h, pdf); 3 environment_irradiance(a); 4 one pass of
 // environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1); 5 sample
-// k = a.x of env_sequence shifted by b. Mode 0 needs the A-S variant (u_ex, u_ey).
+// k = a.x of env_sequence shifted by b; 6 specular_envelope at n = a toward v = c (the
+// ENV_ENVELOPE variant); 7 multipeak_band_cell at h = a.xy over a cell of side b.x.
+// Mode 0 needs the A-S variant (u_ex, u_ey), 7 the multi-peak one.
 #include "fullscreen.glsl"
 
 #ifdef FRAGMENT_SHADER
@@ -42,5 +44,15 @@ void main() {
     } else if (u_mode == 5) {
         frag_color = vec4(env_sequence(int(a.x), b), 1.0);
     }
+#ifdef ENV_ENVELOPE
+    if (u_mode == 6) {
+        frag_color = vec4(specular_envelope(mat, env, a, c), 1.0);
+    }
+#endif
+#ifdef MDF_MULTIPEAK
+    if (u_mode == 7) {
+        frag_color = vec4(multipeak_band_cell(real2(a.xy), mat.mu_f, mat.alpha, mat.beta, b.x));
+    }
+#endif
 }
 #endif

@@ -105,6 +105,63 @@ vec4 env_sample_half(Material mat, Environment env, vec3 u) {
 #endif
 }
 
+vec3 environment_irradiance(Environment env, vec3 n) {
+    vec3 d = env_to_map(env, n);
+    vec3 e = env.sh[0] + env.sh[1] * d.y + env.sh[2] * d.z + env.sh[3] * d.x
+             + env.sh[4] * (d.x * d.y) + env.sh[5] * (d.y * d.z)
+             + env.sh[6] * (3.0 * d.z * d.z - 1.0) + env.sh[7] * (d.x * d.z)
+             + env.sh[8] * (d.x * d.x - d.y * d.y);
+    return max(e, vec3(0.0)) * env.intensity;
+}
+
+#ifdef ENV_ENVELOPE
+// The multi-peak lobe under an environment, D(λ, h) = ½·hz + ½·hz·band(λ, h). Float64
+// twin: opaline/model/envelope.py, which says why and what it measured.
+// * The envelope ½·hz, the same at every wavelength and as wide as the hemisphere: its
+//   albedo A(n·v) times the map's mean radiance about d = n + ½·r (normalised, r the
+//   mirror direction), the irradiance E(d)/π of the diffuse term's nine coefficients.
+// * The bands, which carry the colour: lobe samples, their spectrum shared among a
+//   pass's samples (sample i carries wavelengths i, i + ENV_SAMPLES, …: a pass costs one
+//   spectral evaluation, as one light does), each band box-filtered over the share of
+//   the disc its wavelength's samples stand for. None are drawn (ENV_SAMPLES 0) when
+//   that filter leaves them under 5 % of the envelope anywhere on the lobe.
+vec3 specular_bands(Material mat, vec3 hl, float vh, float nl, float nv, int first,
+                    float cell) {
+    vec3 d = vec3(0.0);
+    for (int i = first; i < WAVELENGTHS; i += max(ENV_SAMPLES, 1)) {
+        d += u_spectral_weight[i] * multipeak_band_cell(
+            rotate_half(real2(hl.xy), u_spectral_rotation[i]), mat.mu_f, mat.alpha, mat.beta, cell);
+    }
+#ifdef FRESNEL
+    float f = fresnel_schlick(vh, mat.f0);
+#else
+    float f = 1.0;
+#endif
+    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
+    return mat.ks * (0.5 * hl.z) * d * (f / denom) * nl;
+}
+
+// ∫ ½·hz·F/(4·v·h·max(n·l, n·v))·n·l dω: (π/8)·(2 − n·v), and with Schlick's F a fit to
+// its (1 − v·h)⁵ part (envelope.SCHLICK_FIT).
+float envelope_albedo(Material mat, float nv) {
+    float plain = PI / 8.0 * (2.0 - nv);
+#ifdef FRESNEL
+    float x = 1.0 - nv;
+    float schlick = ((((((1.42818824 * x - 3.31018136) * x + 3.11136970) * x - 1.31620555)
+                      * x + 0.267333428) * x - 0.0174354895) * x + 0.000192833728);
+    return mat.f0 * plain + (1.0 - mat.f0) * schlick;
+#else
+    return plain;
+#endif
+}
+
+vec3 specular_envelope(Material mat, Environment env, vec3 n, vec3 v) {
+    float nv = clamp(dot(n, v), 0.0, 1.0);
+    vec3 d = normalize(n + 0.5 * (2.0 * dot(n, v) * n - v));
+    return mat.ks * envelope_albedo(mat, nv) * environment_irradiance(env, d) / PI;
+}
+#endif
+
 vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
     vec3 vl = vec3(transpose(frame) * real3(v));
 #ifdef FILM_PER_PIXEL
@@ -113,6 +170,10 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
     g_film_colour = film_rgb(mat.film, clamp(vl.z, 0.0, 1.0), film_thickness_nm(mat.film, film_nm));
 #endif
     vec3 shift = env_pixel_shift();
+#ifdef ENV_ENVELOPE
+    // A wavelength's samples over the pixel: one a pass.
+    float cell = sqrt(PI * float(ENV_SAMPLES) / max(env.total, 1.0));
+#endif
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {
         vec3 u = env_sequence(env.pass * ENV_SAMPLES + i, shift);
@@ -131,20 +192,20 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
         // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
         vec3 l = vec3(frame * real3(ll));
+#ifdef ENV_ENVELOPE
+        vec3 f = specular_bands(mat, s.xyz, vh, ll.z, vl.z, i, cell);
+#else
         vec3 f = specular(mat, frame, l, v, film_nm) * ll.z;
+#endif
         vec3 m = env_to_map(env, l);
         sum += env_lookup(env, m, env_lod(env, m, pdf_l)) * (f / pdf_l);
     }
+#ifdef ENV_ENVELOPE
+    // Each wavelength once a pass: the sum is the pass's estimate of the bands.
+    return max(sum + specular_envelope(mat, env, vec3(frame[2]), v), vec3(0.0));
+#else
     return sum / float(ENV_SAMPLES);
-}
-
-vec3 environment_irradiance(Environment env, vec3 n) {
-    vec3 d = env_to_map(env, n);
-    vec3 e = env.sh[0] + env.sh[1] * d.y + env.sh[2] * d.z + env.sh[3] * d.x
-             + env.sh[4] * (d.x * d.y) + env.sh[5] * (d.y * d.z)
-             + env.sh[6] * (3.0 * d.z * d.z - 1.0) + env.sh[7] * (d.x * d.z)
-             + env.sh[8] * (d.x * d.x - d.y * d.y);
-    return max(e, vec3(0.0)) * env.intensity;
+#endif
 }
 
 #endif

@@ -30,4 +30,20 @@ float mdf_multipeak(real2 h, float hz, real mu_f, real alpha, real beta, float a
     return 0.5 * max(hz, 0.0) * (band + 1.0);
 }
 
+// The bands alone, cos(2π·mu_f·r), box-filtered over a square cell of side `cell` in
+// the projected disc (hx, hy): the pixel's filter above with the phase's slope in h for
+// its screen derivatives. Environment light draws each lobe sample from the disc, where
+// it stands for an area π/N of it (N the wavelength's samples): a cell over many bands
+// reads their mean, as the converged integral over a broad light does, instead of one
+// band's colour; as N grows the cell shrinks to the unfiltered band. The cell is taken
+// in the wavelength's turned frame (a square turned by θ(λ), taken as upright).
+float multipeak_band_cell(real2 h, real mu_f, real alpha, real beta, float cell) {
+    real r = sqrt(alpha * h.x * h.x + beta * h.y * h.y);
+    real cycles = mu_f * r;
+    vec2 slope = vec2(mu_f / max(r, real(1e-6)) * real2(alpha * h.x, beta * h.y));
+    float box = TWO_PI * cell;
+    return cos(TWO_PI * float(cycles - floor(cycles)))
+           * sinc_half(box * abs(slope.x)) * sinc_half(box * abs(slope.y));
+}
+
 #endif

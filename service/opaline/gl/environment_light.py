@@ -18,6 +18,7 @@ from opaline.gl import texture_units
 from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
+from opaline.model.environment_light import band_samples, splits_lobe
 from opaline.model.params import Material
 from opaline.model.request import Job
 
@@ -30,16 +31,21 @@ from opaline.model.request import Job
 FILM_PER_SAMPLE_FROM = 48
 
 
-def samples_per_pass(job: Job, samples: SamplePlan) -> int:
+def samples_per_pass(job: Job, samples: SamplePlan, brute: bool = False) -> int:
+    """A pass's lobe samples; the multi-peak lobe's band samples where it is split (never
+    in the brute-force reference, which samples the whole lobe)."""
     per_pass_pixels = samples.passes * samples.factor * samples.factor
-    return max(1, -(-job.environment_sample_count // per_pass_pixels))
+    per_pass = max(1, -(-job.environment_sample_count // per_pass_pixels))
+    return band_samples(job, per_pass) if splits_lobe(job) and not brute else per_pass
 
 
 def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             brute: bool = False) -> dict[str, int | bool]:
     lights = len(environment.light_directions)
-    return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples),
+    return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples, brute),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
+            # The brute-force reference samples the whole multi-peak lobe at every wavelength.
+            "ENV_ENVELOPE": splits_lobe(job) and not brute,
             "FILM_PER_PIXEL": (job.material.iridescence == "thin-film" and not brute
                                and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
             "LIGHT_COUNT": lights if lights else False}
@@ -59,8 +65,9 @@ def lobe_rotations(material: Material) -> list[tuple[float, float]]:
     return [(math.cos(a), math.sin(a)) for a in (0.0, material.theta1, material.theta2)]
 
 
-def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap) -> Uniforms:
-    per_pixel = samples_per_pass(job, samples) * samples.passes * samples.factor ** 2
+def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
+             brute: bool = False) -> Uniforms:
+    per_pixel = samples_per_pass(job, samples, brute) * samples.passes * samples.factor ** 2
     material = job.material
     rotation = math.radians(job.environment_rotation or 0.0)
     intensity = 1.0 if job.environment_intensity is None else job.environment_intensity

@@ -139,7 +139,7 @@ class SurfacePass:
             environment = self.backgrounds.maps.get(job.environment)
             defines.update(environment_light.defines(job, plan.samples, environment, plan.brute))
             environment.texture.use(location=texture_units.ENVIRONMENT)
-            return environment_light.uniforms(job, plan.samples, environment)
+            return environment_light.uniforms(job, plan.samples, environment, plan.brute)
         lights = light_uniforms(job, preset, self.environments_dir)
         defines["LIGHT_COUNT"] = len(lights["u_light_position"])
         return dict(lights)

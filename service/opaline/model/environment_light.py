@@ -1,32 +1,59 @@
 """How a job's environment lights it, decided once for the renderer and for admission.
 
-The map is read by lobe samples when the lobe is Ashikhmin-Shirley's (the rotation
-source's ``ashikhmin`` MDF, thin film), unless the request asks for lights
-(``environment_lights``). The multi-peak lobe spans the hemisphere and a grating's
-orders are sharp lobes about directions the sampler does not know: for those,
-median-cut lights measured closer to the brute-force reference at every tier
-(bench/environment_accuracy.py, docs/accuracy.md).
+The map is read for the rotation source (either MDF) and thin film, unless the request
+asks for lights (``environment_lights``). Ashikhmin-Shirley lobes and films draw lobe
+samples. The multi-peak lobe is split (``model/envelope.py``): its envelope from the
+map's irradiance, its bands from lobe samples sharing the spectrum, drawn only where
+the pixel's samples resolve them. A grating's orders are sharp lobes about directions
+the sampler does not know: it keeps median-cut lights, which measured closer to the
+brute-force reference (bench/environment_accuracy.py, docs/accuracy.md).
 """
 
 from __future__ import annotations
 
 import math
 
+from opaline.model.envelope import bands_resolved
 from opaline.model.request import Job
 from opaline.scene.bright import MAX_LIGHTS
 
+# Fewer wavelengths a band sample drew the channels from unbalanced sums of the colour
+# matching weights (which go negative): at 6 samples of 16 wavelengths, colour noise
+# took the sphere's FLIP from 0.127 (4 samples) to 0.19.
+WAVELENGTHS_PER_SAMPLE = 4
+
 
 def reads_map(job: Job) -> bool:
-    material = job.material
-    lobe_sampled = material.iridescence == "thin-film" or (
-        material.iridescence == "rotation" and material.mdf == "ashikhmin")
+    lobe_sampled = job.material.iridescence in ("thin-film", "rotation")
     return job.environment is not None and job.environment_lights is None and lobe_sampled
+
+
+def splits_lobe(job: Job) -> bool:
+    """Whether the lobe is the multi-peak one read as envelope and bands (spectral only:
+    the bands' samples share the wavelengths)."""
+    material = job.material
+    return (reads_map(job) and material.iridescence == "rotation"
+            and material.mdf == "multipeak" and job.wavelengths > 0)
+
+
+def band_samples(job: Job, per_pass: int) -> int:
+    """A pass's lobe samples for the multi-peak bands: none where one sample of each
+    wavelength a pass (job.samples over the pixel) cannot resolve them, else at most one
+    for every ``WAVELENGTHS_PER_SAMPLE`` wavelengths."""
+    material = job.material
+    if not bands_resolved(material.mu_f, material.alpha, material.beta, job.samples):
+        return 0
+    return max(1, min(per_pass, job.wavelengths // WAVELENGTHS_PER_SAMPLE))
 
 
 def light_equivalents(job: Job) -> int:
     """What one sample of the job shades, counted in lights: K median-cut lights, or a
     sample's share of the lobe samples plus the bright features split off the map (each
-    lobe sample costs about one light: the reflectance is evaluated once for each)."""
+    lobe sample costs about one light: the reflectance is evaluated once for each; the
+    multi-peak bands' samples of a pass, one spectral evaluation together)."""
     if not reads_map(job):
         return job.environment_count
-    return math.ceil(job.environment_sample_count / job.samples) + MAX_LIGHTS
+    per_pass = math.ceil(job.environment_sample_count / job.samples)
+    if splits_lobe(job):
+        return min(1, band_samples(job, per_pass)) + MAX_LIGHTS
+    return per_pass + MAX_LIGHTS
