@@ -43,11 +43,11 @@ SCHLICK_FIT = (1.42818824e+00, -3.31018136e+00, 3.11136970e+00, -1.31620555e+00,
 def albedo(nv: npt.ArrayLike, f0: float = 1.0) -> FloatArray:
     """∫ ½·hz·F(v·h)/(4·v·h·max(n·l, n·v))·n·l dω over the upper hemisphere: (π/8)·(2 − n·v)
     without Fresnel; with Schlick's F, f0 times that plus (1 − f0) times the fit."""
-    nv = np.clip(np.asarray(nv, dtype=np.float64), 0.0, 1.0)
-    plain = np.pi / 8.0 * (2.0 - nv)
+    cosine = np.clip(np.asarray(nv, dtype=np.float64), 0.0, 1.0)
+    plain: FloatArray = np.pi / 8.0 * (2.0 - cosine)
     if f0 >= 1.0:
         return plain
-    schlick: FloatArray = np.polyval(SCHLICK_FIT, 1.0 - nv)
+    schlick: FloatArray = np.polyval(SCHLICK_FIT, 1.0 - cosine)
     result: FloatArray = f0 * plain + (1.0 - f0) * schlick
     return result
 
