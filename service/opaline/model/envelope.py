@@ -47,7 +47,7 @@ def albedo(nv: npt.ArrayLike, f0: float = 1.0) -> FloatArray:
     plain: FloatArray = np.pi / 8.0 * (2.0 - cosine)
     if f0 >= 1.0:
         return plain
-    schlick: FloatArray = np.polyval(SCHLICK_FIT, 1.0 - cosine)
+    schlick = np.polyval(np.asarray(SCHLICK_FIT), 1.0 - cosine).astype(np.float64)
     result: FloatArray = f0 * plain + (1.0 - f0) * schlick
     return result
 
