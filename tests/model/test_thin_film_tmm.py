@@ -107,7 +107,7 @@ def abeles(cos0, lam, d, n_film, n_sub):
     films, subs = np.conj(n_film + 0j), np.conj(n_sub + 0j)
     out = []
     for p in (False, True):
-        def admittance(n):
+        def admittance(n, p=p):
             n_cos = np.sqrt(n * n - sin2 + 0j)  # Im ≤ 0 for n - ik: the decaying root
             return n * n / n_cos if p else n_cos
 
