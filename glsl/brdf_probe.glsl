@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL PRECISE_PHASE IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS SUBSTRATE_CONDUCTOR
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL PRECISE_PHASE IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS SUBSTRATE_CONDUCTOR FILM_WEIGHT
 // Test harness: each pixel shades one (n, t, l, v) case read from float
 // textures, through the same reflectance code the surfaces use, so the GLSL
 // can be compared with the float64 reference case by case.

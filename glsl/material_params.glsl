@@ -54,6 +54,9 @@ uniform float u_film_ior;
 uniform float u_substrate_ior;
 uniform float u_film_thickness_min;
 uniform float u_film_thickness_max;
+#ifdef FILM_WEIGHT
+uniform float u_film_weight;
+#endif
 #endif
 #ifdef IRIDESCENCE_GRATING
 uniform float u_grating_pitch_nm;
@@ -99,6 +102,9 @@ Material material_params() {
     mat.film.substrate_ior = u_substrate_ior;
     mat.film.thickness_min = u_film_thickness_min;
     mat.film.thickness_max = u_film_thickness_max;
+#ifdef FILM_WEIGHT
+    mat.film.weight = u_film_weight;
+#endif
 #endif
 #ifdef IRIDESCENCE_GRATING
     mat.grating.pitch_nm = u_grating_pitch_nm;

@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -193,8 +193,8 @@ void main() {
     // A free, lossless film transmits what it does not reflect: the backdrop seen
     // through both walls, each met at the view's angle to the surface (the back
     // wall's own thickness is not known: this one's is used).
-    vec3 through = vec3(1.0) - film_rgb(mat.film, abs(float(dot(frame[2], v))),
-                                     film_thickness_nm(mat.film, film_nm));
+    vec3 through = vec3(1.0) - film_layer_rgb(mat.film, abs(float(dot(frame[2], v))),
+                                           film_thickness_nm(mat.film, film_nm));
 #ifdef ENV_BACKDROP
     // The environment behind, straight through the film, where it is the background.
     vec3 behind = env_lookup(env, env_to_map(env, -v), 0.0);

@@ -167,7 +167,8 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
 #ifdef FILM_PER_PIXEL
     // At the mirror direction's v·h = n·v: over a glossy lobe v·h hardly moves, and the
     // film is most of a sample's cost (the Sample Viewer's split sum does the same).
-    g_film_colour = film_rgb(mat.film, clamp(vl.z, 0.0, 1.0), film_thickness_nm(mat.film, film_nm));
+    g_film_colour = film_layer_rgb(mat.film, clamp(vl.z, 0.0, 1.0),
+                                   film_thickness_nm(mat.film, film_nm));
 #endif
     vec3 shift = env_pixel_shift();
 #ifdef ENV_ENVELOPE

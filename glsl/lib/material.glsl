@@ -30,6 +30,9 @@ struct Film {  // lib/thin_film.glsl
     float substrate_ior;  // not read over a conductor: its n + ik is a table
     float thickness_min;  // nm: a thickness map's 0
     float thickness_max;  // nm: its 1, and the thickness without a map
+#ifdef FILM_WEIGHT
+    float weight;  // KHR iridescenceFactor: mix(bare substrate, film, weight); 1 without
+#endif
 };
 #endif
 #ifdef IRIDESCENCE_GRATING

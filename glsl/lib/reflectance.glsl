@@ -21,7 +21,7 @@ vec3 film_colour(Material mat, float vh, float film_nm) {
 }
 #else
 vec3 film_colour(Material mat, float vh, float film_nm) {
-    return film_rgb(mat.film, vh, film_thickness_nm(mat.film, film_nm));
+    return film_layer_rgb(mat.film, vh, film_thickness_nm(mat.film, film_nm));
 }
 #endif
 #endif

@@ -12,6 +12,9 @@
 //   vec3 u_film_sens_weight[3], u_film_sens_centre[3], u_film_sens_sigma[3];
 //                                                 with WAVELENGTHS = 0 (see film_rgb)
 //   vec2 u_substrate_nk[WAVELENGTHS, or 3 for R, G, B];  with SUBSTRATE_CONDUCTOR
+// What the surface reflects is film_layer_rgb: the film over its base, by film.weight
+// (KHR iridescenceFactor) where FILM_WEIGHT is compiled in (a weight below 1), else the
+// film alone, as before the weight existed.
 #ifndef THIN_FILM_GLSL
 #define THIN_FILM_GLSL
 #include "lib/common.glsl"
@@ -47,7 +50,21 @@ bool film_interfaces(Film film, float cos1, out float cos2, out vec2 r12, out ve
 
 #ifdef SUBSTRATE_CONDUCTOR
 #include "lib/thin_film_conductor.glsl"
-#elif WAVELENGTHS > 0
+#else
+// The base without its film: the bare substrate's Fresnel reflectance from air, s and p
+// averaged, white (the colour weights of both paths sum to 1 per channel). All is
+// reflected exactly at grazing, as film_interfaces has it.
+vec3 film_base_rgb(Film film, float cos1) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    float ns = film.substrate_ior;
+    float cos3_sq = (ns * ns - 1.0 + cos1 * cos1) / (ns * ns);
+    float cos3 = sqrt(max(cos3_sq, 0.0));
+    vec2 r = vec2(film_ratio(cos1 - ns * cos3, cos1 + ns * cos3),
+                  film_ratio(ns * cos1 - cos3, ns * cos1 + cos3));
+    return vec3(cos1 > 0.0 && cos3_sq > 0.0 ? 0.5 * dot(r, r) : 1.0);
+}
+
+#if WAVELENGTHS > 0
 float film_airy(float a, float b, float c) {
     float ab = a * b;
     // The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
@@ -127,6 +144,18 @@ vec3 film_rgb(Film film, float cos1, float d) {
     }
     return max(rgb, vec3(0.0));
 }
+#endif  // WAVELENGTHS
+#endif  // SUBSTRATE_CONDUCTOR
+
+// KHR_materials_iridescence's layering: the film's reflectance mixed with its base's by
+// the weight (the Sample Viewer mixes the two Fresnel terms by iridescenceFactor). Without
+// FILM_WEIGHT (weight 1) the base is not compiled in: a whole film costs what it did.
+vec3 film_layer_rgb(Film film, float cos1, float d) {
+#ifdef FILM_WEIGHT
+    return mix(film_base_rgb(film, cos1), film_rgb(film, cos1, d), film.weight);
+#else
+    return film_rgb(film, cos1, d);
 #endif
+}
 
 #endif

@@ -52,6 +52,16 @@ vec4 film_conductor_r23(float nf, float cos1, float cos2, vec2 nk) {
     return vec4(c_div(top_s - n_cos3, top_s + n_cos3), c_div(top_p - bottom_p, top_p + bottom_p));
 }
 
+// The bare metal's Fresnel reflectance from air (s and p averaged): the lower interface
+// with the film's index 1. All is reflected exactly at grazing, as film_top has it.
+float film_bare_conductor(float cos1, vec2 nk) {
+    if (cos1 <= 0.0) {
+        return 1.0;
+    }
+    vec4 r = film_conductor_r23(1.0, cos1, cos1, nk);
+    return 0.5 * (dot(r.xy, r.xy) + dot(r.zw, r.zw));
+}
+
 #if WAVELENGTHS > 0
 // u_substrate_nk: n + ik at each wavelength.
 // One polarisation: a real, b complex, e = e^{iφ}.
@@ -59,6 +69,16 @@ float film_airy_complex(float a, vec2 b, vec2 e) {
     float b2 = dot(b, b);
     float re = b.x * e.x - b.y * e.y;  // Re(b·e^{iφ})
     return max(a * a + b2 + 2.0 * a * re, 0.0) / max(1.0 + a * a * b2 + 2.0 * a * re, 1e-30);
+}
+
+// The base without its film: the bare metal, integrated as the film is.
+vec3 film_base_rgb(Film film, float cos1) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        sum += u_spectral_weight[i] * film_bare_conductor(cos1, u_substrate_nk[i]);
+    }
+    return max(sum, vec3(0.0));
 }
 
 vec3 film_rgb(Film film, float cos1, float d) {
@@ -115,6 +135,14 @@ float film_channel(int c, float nf, float cos1, float cos2, vec2 r12, float opd_
         }
     }
     return value;
+}
+
+// The base without its film: the bare metal at each channel's n + ik.
+vec3 film_base_rgb(Film film, float cos1) {
+    cos1 = clamp(cos1, 0.0, 1.0);
+    return vec3(film_bare_conductor(cos1, u_substrate_nk[0]),
+                film_bare_conductor(cos1, u_substrate_nk[1]),
+                film_bare_conductor(cos1, u_substrate_nk[2]));
 }
 
 vec3 film_rgb(Film film, float cos1, float d) {

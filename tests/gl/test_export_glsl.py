@@ -40,6 +40,11 @@ VARIANTS = {
                                     metal="titanium", film_ior=2.4), 16),
     "conductor-fast": (Material(iridescence="thin-film", substrate="conductor", metal="gold",
                                 film_ior=1.5, film_thickness_max=120.0), 0),
+    # A partial film: the base's Fresnel and the weight compiled in (FILM_WEIGHT).
+    "film-weight": (Material(mdf="ashikhmin", iridescence="thin-film", film_weight=0.4,
+                             film_thickness_max=300.0), 0),
+    "conductor-weight": (Material(iridescence="thin-film", substrate="conductor",
+                                  metal="copper", film_weight=0.6), 16),
 }
 
 

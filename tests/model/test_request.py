@@ -147,7 +147,7 @@ CHANGED_MATERIAL = {
     "iridescence": "thin-film", "film_ior": 1.4, "film_thickness_min": 120.0,
     "film_thickness_max": 420.0, "substrate_ior": 1.33, "grating_pitch": 0.74,
     "grating_orders": 2, "grating_depth": 120.0, "substrate": "conductor", "metal": "artist",
-    "metal_f0": (0.9, 0.6, 0.3), "metal_edge_tint": (1.0, 0.9, 0.8),
+    "metal_f0": (0.9, 0.6, 0.3), "metal_edge_tint": (1.0, 0.9, 0.8), "film_weight": 0.5,
 }
 
 

@@ -174,3 +174,25 @@ def test_film_on_a_metal_exports_a_metallic_base_of_its_f0():
     assert fields["substrate"] == "conductor" and fields["metal"] == "artist"
     assert fields["metal_f0"] == pytest.approx([red, green, blue]) and fields["kd"] == 0.0
     RenderRequest.model_validate(fields)
+
+
+def test_partial_film_round_trips_as_its_factor():
+    """iridescenceFactor is film_weight both ways (issue 23): a KHR-only .glb whose factor
+    is 0.5 imports as a half-weight film, not a whole one, and that material exports the
+    factor 0.5 again (with the film's other values, extras or not); a factor beyond 1 is
+    refused naming the field."""
+    film = {"iridescenceFactor": 0.5, "iridescenceIor": 1.6,
+            "iridescenceThicknessMinimum": 80.0, "iridescenceThicknessMaximum": 520.0}
+    fields = import_glb(_khr_only(film, 1.4))
+    assert fields["film_weight"] == 0.5
+    request = RenderRequest.model_validate({"preset": "oil-film", **fields})
+    data = export_material(request, "glb")
+    exported = _load(data).materials[0].extensions["KHR_materials_iridescence"]
+    assert {k: exported[k] for k in film} == film
+    assert "iridescenceThicknessTexture" in exported  # the preset's field, as before
+    assert import_glb(data)["film_weight"] == 0.5  # through the extras
+    document = _load(data)
+    document.materials[0].extras = {}
+    assert import_glb(b"".join(document.save_to_bytes()))["film_weight"] == 0.5
+    with pytest.raises(ValueError, match="film_weight"):
+        import_glb(_khr_only({**film, "iridescenceFactor": 1.5}, 1.4))

@@ -78,11 +78,19 @@ def material_defines(material: Material, wavelengths: int = 0, aa: str = "none")
         defines.update(_physical_defines(material))  # applied last: the physical source wins
     if is_conductor(material):
         defines["SUBSTRATE_CONDUCTOR"] = True
+    if has_film_weight(material):
+        defines["FILM_WEIGHT"] = True
     return defines
 
 
 def is_conductor(material: Material) -> bool:
     return material.iridescence == "thin-film" and material.substrate == "conductor"
+
+
+def has_film_weight(material: Material) -> bool:
+    """A partial film: its base is compiled in only then (a whole film, the default, and
+    every variant before the weight existed, compile as they did)."""
+    return material.iridescence == "thin-film" and material.film_weight < 1.0
 
 
 def uses_thickness_map(material: Material, preset: Preset) -> bool:
@@ -149,6 +157,7 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
         "u_substrate_ior": material.substrate_ior,
         "u_film_thickness_min": material.film_thickness_min,
         "u_film_thickness_max": material.film_thickness_max,
+        "u_film_weight": material.film_weight,
         "u_grating_pitch_nm": 1000.0 * material.grating_pitch,
         "u_grating_depth_nm": material.grating_depth,
     }

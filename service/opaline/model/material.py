@@ -81,6 +81,11 @@ class Material(BaseModel):
     film_ior: FilmIor = Field(
         1.3, json_schema_extra=about(PHYSICAL, iridescence=FILM),
         description="Thin film's refractive index (KHR iridescenceIor), 1 … 3.")
+    film_weight: Unit = Field(
+        1.0, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="How much of the film there is (KHR iridescenceFactor, OpenPBR "
+        "thin_film_weight): the specular colour is mix(bare substrate, film, weight); 0 is the "
+        "substrate's own Fresnel reflectance, 1 the whole film, 0 … 1.")
     film_thickness_min: Thickness = Field(
         100.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=FILM),
         description="Film thickness in nm where the thickness field is 0 "

@@ -44,7 +44,8 @@ def specular_thin_film(
     nv = np.sum(n * v, axis=-1)
     thickness = material.film_thickness_max if thickness_nm is None else thickness_nm
     substrate = metals.substrate_for(material, wavelengths)
-    film = thinfilm.film_rgb(vh, thickness, material.film_ior, substrate, wavelengths)
+    film = thinfilm.film_layer_rgb(vh, thickness, material.film_ior, substrate,
+                                   material.film_weight, wavelengths)
     denom = 4.0 * np.maximum(vh, EPS_DENOM) * np.maximum(np.maximum(nl, nv), EPS_DENOM)
     spec = material.ks * film * (d / denom)[..., None]
     return np.where(length > EPS_HALF, spec, 0.0)

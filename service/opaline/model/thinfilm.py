@@ -200,6 +200,37 @@ def film_rgb_fast_conductor(
     return rgb
 
 
+def film_base_rgb(cos1: npt.ArrayLike, n_sub: Substrate, wavelengths: int = 0) -> FloatArray:
+    """The base without its film: the bare substrate's Fresnel reflectance from air (the
+    lower interface under a film of index 1), s and p averaged, 1 exactly at grazing;
+    white over a dielectric (each path's colour weights sum to 1), a metal's integrated
+    as the film is (per wavelength, or per channel's n + ik)."""
+    cos1 = np.clip(np.asarray(cos1, dtype=np.float64), 0.0, 1.0)
+    if not np.iscomplexobj(n_sub):
+        _, _, (rs, rp), tir = interfaces(cos1, 1.0, n_sub)
+        bare = np.where(tir, 1.0, 0.5 * (rs * rs + rp * rp))
+        return np.repeat(bare[..., None], 3, axis=-1)
+    _, _, (rs, rp), tir = interfaces(cos1[..., None], 1.0, np.asarray(n_sub))
+    bare = np.where(tir, 1.0, 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2))
+    if wavelengths > 0:
+        bare = bare @ rgb_weights(wavelengths)
+    rgb: FloatArray = np.maximum(bare, 0.0)
+    return rgb
+
+
+def film_layer_rgb(
+    cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: Substrate,
+    weight: float = 1.0, wavelengths: int = 0,
+) -> FloatArray:
+    """KHR_materials_iridescence's layering: mix(base, film, weight) (iridescenceFactor)."""
+    film = film_rgb(cos1, d_nm, n_film, n_sub, wavelengths)
+    if weight >= 1.0:
+        return film
+    base = film_base_rgb(cos1, n_sub, wavelengths)
+    mixed: FloatArray = base + weight * (film - base)
+    return mixed
+
+
 def film_rgb(
     cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: Substrate,
     wavelengths: int = 0,

@@ -1,7 +1,7 @@
 """Thin-film materials in glTF: KHR_materials_iridescence (and KHR_materials_ior) both ways.
 
-Export maps a ``thin-film`` material exactly: iridescenceFactor 1 (Opaline has no
-blend between film and bare substrate), iridescenceIor = film_ior,
+Export maps a ``thin-film`` material exactly: iridescenceFactor = film_weight (both
+mix the bare base's Fresnel term with the film's by it), iridescenceIor = film_ior,
 iridescenceThicknessMinimum/Maximum = film_thickness_min/max (nm), and the base
 material's KHR_materials_ior ior = substrate_ior, because KHR's Airy term takes
 the base material's IOR as the medium under the film (n3), as Opaline does. A
@@ -13,11 +13,15 @@ the metal's reflectance under the film; a metallic file imports back as the
 iridescenceThicknessTexture: 8-bit grey RGB (KHR reads G), 1/255 of the range
 per step.
 
-Import reads the same names back, with the extension's defaults (ior 1.3,
-thickness 100-400 nm) where a key is absent and the glTF base ior 1.5 without
-KHR_materials_ior. A thickness texture in the file is not imported: the request
-has no per-material thickness field (it belongs to the preset), so the film is
-film_thickness_max everywhere, as KHR's is without a texture.
+Import reads the same names back, iridescenceFactor into film_weight (a factor of 0,
+no film, is refused: that is a plain material), with the extension's defaults (ior
+1.3, thickness 100-400 nm) where a key is absent and the glTF base ior 1.5 without
+KHR_materials_ior. Neither texture in the file is imported: a request has no
+thickness field of its own (a thickness field belongs to the preset, and a user's mesh
+takes its preset's), so the film is film_thickness_max everywhere, as KHR's is without
+a thickness texture; and the weight is one number per material, so an
+iridescenceTexture (KHR's per-texel factor, R) is not read: iridescenceFactor alone
+gives film_weight.
 """
 
 from __future__ import annotations
@@ -49,7 +53,7 @@ def is_thin_film(material: Material) -> bool:
 def thin_film_extensions(material: Material, thickness_texture: int | None) -> dict[str, Any]:
     """The material's ``extensions`` entries; ``thickness_texture``: a texture index or None."""
     film: dict[str, Any] = {
-        "iridescenceFactor": 1.0,
+        "iridescenceFactor": float(material.film_weight),
         "iridescenceIor": float(material.film_ior),
         "iridescenceThicknessMinimum": float(material.film_thickness_min),
         "iridescenceThicknessMaximum": float(material.film_thickness_max),
@@ -125,7 +129,8 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     ior = extensions.get(IOR) or {}
     if not isinstance(film, dict) or not isinstance(ior, dict):
         raise ValueError(f"{IRIDESCENCE} must be an object")
-    if _number(film, "iridescenceFactor", 0.0) <= 0.0:
+    factor = _number(film, "iridescenceFactor", 0.0)
+    if factor <= 0.0:
         raise ValueError(f"{IRIDESCENCE} has iridescenceFactor 0: the film is off")
     pbr = material.pbrMetallicRoughness or gl.PbrMetallicRoughness()
     metallic = pbr.metallicFactor if pbr.metallicFactor is not None else 1.0
@@ -134,6 +139,7 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
         pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0)
     fields = {
         "iridescence": "thin-film",
+        "film_weight": factor,
         "film_ior": _number(film, "iridescenceIor", KHR_IOR),
         "film_thickness_min": _number(film, "iridescenceThicknessMinimum", KHR_THICKNESS_MIN),
         "film_thickness_max": _number(film, "iridescenceThicknessMaximum", KHR_THICKNESS_MAX),
