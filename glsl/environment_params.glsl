@@ -17,7 +17,8 @@ uniform vec3 u_env_sh[9];
 
 Environment environment_params() {
     Environment env;
-    env.rotation = u_env_rotation;
+    // Once a fragment, not at each of its lobe samples.
+    env.turn = vec2(cos(u_env_rotation), sin(u_env_rotation));
     env.intensity = u_env_intensity;
     env.size = u_env_size;
     env.max_lod = u_env_max_lod;

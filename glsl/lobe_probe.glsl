@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE FILM_WEIGHT
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES FILM_WEIGHT
 // Test harness for environment light: each pixel runs one case read from float
 // textures through lib/lobe_sampling.glsl and lib/environment_light.glsl, so the
 // samplers, the irradiance and the estimator can be held against their float64

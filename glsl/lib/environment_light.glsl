@@ -19,7 +19,7 @@
 #include "lib/lobe_sampling.glsl"
 
 struct Environment {
-    float rotation;  // radians the environment is turned about +y
+    vec2 turn;  // (cos, sin) of the angle the environment is turned about +y
     float intensity;
     vec2 size;  // the map's level 0, texels
     float max_lod;
@@ -31,8 +31,8 @@ struct Environment {
 
 // Into the map's own frame (the environment turns, the object stays).
 vec3 env_to_map(Environment env, vec3 d) {
-    float c = cos(env.rotation);
-    float s = sin(env.rotation);
+    float c = env.turn.x;
+    float s = env.turn.y;
     return vec3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
 }
 
@@ -82,6 +82,12 @@ vec3 env_sequence(int k, vec3 shift) {
     return fract(shift + vec3(fraction) * (1.0 / 4294967296.0));
 }
 
+#if !defined(MDF_MULTIPEAK) && !defined(IRIDESCENCE_GRATING) && !defined(IRIDESCENCE_THIN_FILM)
+// The three channels' lobes at the rotation source's last sample: its density's terms,
+// and the paper's colour there (specular_rgb_lobes), evaluated once for both.
+vec3 g_env_lobes;
+#endif
+
 // A half vector from the lobe and the density of the whole mixture there.
 vec4 env_sample_half(Material mat, Environment env, vec3 u) {
 #if defined(MDF_MULTIPEAK) || defined(IRIDESCENCE_GRATING)
@@ -97,11 +103,10 @@ vec4 env_sample_half(Material mat, Environment env, vec3 u) {
     vec4 s = sample_ashikhmin(u.xy, mat.ex, mat.ey);
     vec2 cs = env.lobe_rotation[c];
     vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
-    float pdf = 0.0;
     for (int i = 0; i < 3; ++i) {
-        pdf += mdf_ashikhmin(rotate_half(h.xy, env.lobe_rotation[i]), h.z, mat.ex, mat.ey);
+        g_env_lobes[i] = mdf_ashikhmin(rotate_half(h.xy, env.lobe_rotation[i]), h.z, mat.ex, mat.ey);
     }
-    return vec4(h, pdf / 3.0);
+    return vec4(h, (g_env_lobes.x + g_env_lobes.y + g_env_lobes.z) / 3.0);
 #endif
 }
 
@@ -113,6 +118,26 @@ vec3 environment_irradiance(Environment env, vec3 n) {
              + env.sh[8] * (d.x * d.x - d.y * d.y);
     return max(e, vec3(0.0)) * env.intensity;
 }
+
+#ifdef ENV_RGB_LOBES
+// The rotation source's map samples in the paper's own colour (eq. 2): one lobe for each
+// channel, turned by 0, θ1, θ2, the very lobes the mixture draws from (their values at
+// the sample, g_env_lobes, are its density's terms), so a sample's weight D_c/pdf stays
+// under 3. Set below 48 samples a pixel (gl/environment_light.py): there the
+// 16-wavelength colour cost 3× as much a sample and measured no closer to the spectral
+// brute-force reference (FLIP 0.106 either way at 6 samples), while the spectral lobe
+// is still what lights (the preset's, a map's bright features) evaluate.
+vec3 specular_rgb_lobes(Material mat, float vh, float nl, float nv) {
+    vec3 d = g_env_lobes;
+#ifdef FRESNEL
+    float f = fresnel_schlick(vh, mat.f0);
+#else
+    float f = 1.0;
+#endif
+    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
+    return mat.ks * d * (f / denom) * nl;
+}
+#endif
 
 #ifdef ENV_ENVELOPE
 // The multi-peak lobe under an environment, D(λ, h) = ½·hz + ½·hz·band(λ, h). Float64
@@ -193,8 +218,10 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
         // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
         vec3 l = vec3(frame * real3(ll));
-#ifdef ENV_ENVELOPE
+#if defined(ENV_ENVELOPE)
         vec3 f = specular_bands(mat, s.xyz, vh, ll.z, vl.z, i, cell);
+#elif defined(ENV_RGB_LOBES)
+        vec3 f = specular_rgb_lobes(mat, vh, ll.z, vl.z);
 #else
         vec3 f = specular(mat, frame, l, v, film_nm) * ll.z;
 #endif

@@ -23,7 +23,8 @@ from opaline.model.params import Material
 from opaline.model.request import Job
 
 # From this many samples a pixel, the film is evaluated at each sample's own v·h; below
-# (draft's 2, standard's 6), once at n·v. Measured against the brute-force reference
+# (draft's 2, standard's 6), once at n·v; and the rotation source's map samples take the
+# spectral colour, below it the paper's three channels (environment_light.glsl). Measured against the brute-force reference
 # (bench/environment_accuracy.py, studio, 128²): once per pixel costs FLIP +0.000-0.005
 # at 2-4 samples, where it makes a standard-tier film 1.1-1.3× its key-lit time instead
 # of 2-2.8×, but leaves a floor near 0.01 that the high tier (64 samples, 0.003-0.006
@@ -48,6 +49,11 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
             "FILM_PER_PIXEL": (job.material.iridescence == "thin-film" and not brute
                                and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
+            # The same threshold for the rotation source's spectrum (environment_light.glsl).
+            "ENV_RGB_LOBES": (job.material.iridescence == "rotation"
+                              and job.material.mdf == "ashikhmin" and job.wavelengths > 0
+                              and not brute
+                              and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
             "LIGHT_COUNT": lights if lights else False}
 
 

@@ -130,19 +130,22 @@ class Probes:
     def lobe(self, material: Material, mode: str, cases: tuple[np.ndarray, ...],
              environment: tuple[moderngl.Texture, np.ndarray] | None = None,
              rotation: float = 0.0, intensity: float = 1.0, samples: int = 1,
-             passes: int = 1, brute: bool = True, wavelengths: int = 0) -> np.ndarray:
+             passes: int = 1, brute: bool = True, wavelengths: int = 0,
+             rgb_lobes: bool = False) -> np.ndarray:
         """glsl/lobe_probe.glsl for each case (up to three (count, 3) inputs, see its
         modes in ``LOBE_MODES``): (passes, count, 4), pass k continuing the pixel's
         sequence as the surface's passes do. ``environment``: the map's texture and
         irradiance coefficients (gl/background.py's), ``samples`` a pass's lobe samples,
         ``brute`` level 0 always (else the filtered read, for ``samples · passes`` in all);
         ``wavelengths`` > 0: the spectral variant, split into envelope and bands where the
-        lobe is the multi-peak one (model/envelope.py)."""
+        lobe is the multi-peak one (model/envelope.py); ``rgb_lobes``: the rotation
+        source's map samples in the paper's three channels."""
         res = self.resources
         res.gl.make_current()
         defines = {**material_program.material_defines(material, wavelengths),
                    "ENV_SAMPLES": samples, "ENV_BRUTE": brute,
-                   "ENV_ENVELOPE": wavelengths > 0 and material.mdf == "multipeak"}
+                   "ENV_ENVELOPE": wavelengths > 0 and material.mdf == "multipeak",
+                   "ENV_RGB_LOBES": rgb_lobes}
         program = res.programs.get("lobe_probe.glsl", defines)
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,

@@ -80,7 +80,12 @@ class Job:
     @property
     def environment_sample_count(self) -> int:
         """Lobe samples per pixel that read the environment map, the job's or its tier's."""
-        return self.environment_samples or self.tier.environment_samples
+        if self.environment_samples:
+            return self.environment_samples
+        material = self.material
+        if material.iridescence == "rotation" and material.mdf == "ashikhmin":
+            return self.tier.environment_samples_rotation
+        return self.tier.environment_samples
 
     @property
     def cost(self) -> int:

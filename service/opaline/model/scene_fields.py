@@ -77,8 +77,11 @@ class SceneFields(BaseModel):
     environment_samples: Annotated[int, Field(ge=1, le=4096)] | None = Field(
         None, description="Directions drawn from the material's lobe per pixel to read the "
                           "environment map, 1 … 4096 (default: the tier's: draft 2, standard "
-                          "6, high 64, reference 1024). Ignored where the environment becomes "
-                          "lights (environment_lights set, or a grating).")
+                          "6, high 64, reference 1024; for the rotation source's "
+                          "Ashikhmin-Shirley lobes draft 3, standard 9). The multi-peak lobe's "
+                          "bands take at most one a pass per 4 wavelengths, and none where "
+                          "the pixel's samples cannot resolve them. Ignored where the "
+                          "environment becomes lights (environment_lights set, or a grating).")
     environment_background: bool | None = Field(
         None, description="Show the environment behind the object instead of the preset's "
                           "background (default false).")

@@ -43,6 +43,10 @@ class Tier:
     # Directions per pixel drawn from the material's lobe to read the environment map
     # (glsl/lib/environment_light.glsl), over all the tier's samples together.
     environment_samples: int
+    # The same for the rotation source's three Ashikhmin-Shirley lobes (a multiple of 3,
+    # each lobe its share): against the brute-force reference (studio, A-S 100×1000,
+    # θ 0.5/1.0) 6 left FLIP 0.106, 9 0.088, 12 0.079 (bench/environment_accuracy.py).
+    environment_samples_rotation: int
     measured: Measured | None = None  # quality=auto only
 
     def render_settings(self) -> dict[str, int | str]:
@@ -53,7 +57,8 @@ class Tier:
         """The tier as GET /v1/tiers and ``--help`` show it."""
         return {"name": self.name, **self.render_settings(),
                 "environment_lights": self.environment_lights,
-                "environment_samples": self.environment_samples}
+                "environment_samples": self.environment_samples,
+                "environment_samples_rotation": self.environment_samples_rotation}
 
 
 TIERS: dict[str, Tier] = {tier.name: tier for tier in (
@@ -62,17 +67,17 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # buy wavelengths before samples: one sample of 8 wavelengths, band-limited, costs
     # little more than one RGB sample and has a third to half of its error.
     Tier("draft", samples=1, wavelengths=8, aa="analytic",
-         environment_lights=8, environment_samples=2),
+         environment_lights=8, environment_samples=2, environment_samples_rotation=3),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
-         environment_lights=16, environment_samples=6),
+         environment_lights=16, environment_samples=6, environment_samples_rotation=9),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
     Tier("high", samples=8, wavelengths=16, aa="none",
-         environment_lights=32, environment_samples=64),
+         environment_lights=32, environment_samples=64, environment_samples_rotation=64),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
     Tier("reference", samples=64, wavelengths=32, aa="none",
-         environment_lights=64, environment_samples=1024),
+         environment_lights=64, environment_samples=1024, environment_samples_rotation=1024),
 )}
 if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
     raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
@@ -91,4 +96,6 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
     high = TIERS["high"]
     return Tier("auto", samples, wavelengths, aa,
                 max(like.environment_lights, high.environment_lights),
-                max(like.environment_samples, high.environment_samples), measured)
+                max(like.environment_samples, high.environment_samples),
+                max(like.environment_samples_rotation, high.environment_samples_rotation),
+                measured)

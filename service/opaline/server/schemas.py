@@ -59,3 +59,6 @@ class TierInfo(BaseModel):
                                                 "where it is drawn as lights.")
     environment_samples: int = Field(description="Lobe samples per pixel that read the "
                                                  "environment map.")
+    environment_samples_rotation: int = Field(
+        description="The same for the rotation source's Ashikhmin-Shirley lobes (three of "
+                    "them, one a channel).")
