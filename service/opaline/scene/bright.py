@@ -19,6 +19,7 @@ from opaline.scene.mediancut import LUMA, directions, median_cut
 
 BRIGHT_OVER_MEAN = 50.0
 MAX_LIGHTS = 4
+MERGE_DEGREES = 3.0
 
 
 def split_bright(radiance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -34,4 +35,29 @@ def split_bright(radiance: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     scale = np.minimum(1.0, threshold / np.maximum(luma, 1e-30))[..., None]
     kept = (radiance * scale).astype(np.float32)
     direction, irradiance = median_cut(radiance - kept, MAX_LIGHTS)
+    direction, irradiance = merge_close(direction, irradiance)
     return kept, direction, irradiance
+
+
+def merge_close(direction: np.ndarray, irradiance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lights within ``MERGE_DEGREES`` of a brighter one folded into it (energy-weighted
+    direction, summed irradiance): median cut splits one small source (a sun of 0.5°)
+    into up to MAX_LIGHTS lights a fraction of a degree apart, each a full evaluation of
+    the reflectance, where one light at their centroid lights every lobe the same to
+    within the source's own size."""
+    order = np.argsort(-(irradiance @ LUMA), kind="stable")
+    cos_limit = np.cos(np.radians(MERGE_DEGREES))
+    groups: list[list[int]] = []
+    for index in order:
+        home = next((g for g in groups if direction[g[0]] @ direction[index] >= cos_limit), None)
+        if home is None:
+            groups.append([int(index)])
+        else:
+            home.append(int(index))
+    merged_d, merged_e = [], []
+    for group in groups:
+        weight = irradiance[group] @ LUMA
+        d = (direction[group] * np.maximum(weight, 1e-30)[:, None]).sum(0)
+        merged_d.append(d / np.linalg.norm(d))
+        merged_e.append(irradiance[group].sum(0))
+    return np.array(merged_d).reshape(-1, 3), np.array(merged_e).reshape(-1, 3)
