@@ -219,14 +219,19 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
         vec3 l = vec3(frame * real3(ll));
 #if defined(ENV_ENVELOPE)
-        vec3 f = specular_bands(mat, s.xyz, vh, ll.z, vl.z, i, cell);
+        vec3 weight = specular_bands(mat, s.xyz, vh, ll.z, vl.z, i, cell) / pdf_l;
 #elif defined(ENV_RGB_LOBES)
-        vec3 f = specular_rgb_lobes(mat, vh, ll.z, vl.z);
+        vec3 weight = specular_rgb_lobes(mat, vh, ll.z, vl.z) / pdf_l;
+#elif defined(IRIDESCENCE_THIN_FILM)
+        // Drawn from the film's own lobe, whose density is D(h): D/pdf is 1 and the lobe
+        // is not evaluated again, f·n·l/pdf_l = ks·film·n·l/max(n·l, n·v).
+        vec3 weight = mat.ks * film_colour(mat, vh, film_nm)
+                      * (ll.z / max(max(ll.z, vl.z), EPS_DENOM));
 #else
-        vec3 f = specular(mat, frame, l, v, film_nm) * ll.z;
+        vec3 weight = specular(mat, frame, l, v, film_nm) * ll.z / pdf_l;
 #endif
         vec3 m = env_to_map(env, l);
-        sum += env_lookup(env, m, env_lod(env, m, pdf_l)) * (f / pdf_l);
+        sum += env_lookup(env, m, env_lod(env, m, pdf_l)) * weight;
     }
 #ifdef ENV_ENVELOPE
     // Each wavelength once a pass: the sum is the pass's estimate of the bands.

@@ -37,7 +37,8 @@ vec4 sample_ashikhmin(vec2 u, float ex, float ey) {
     float one_minus_hz = one_minus_exp(t);
     float sin_h = sqrt(max(one_minus_hz * (2.0 - one_minus_hz), 0.0));
     vec3 h = vec3(sin_h * c, sin_h * s, 1.0 - one_minus_hz);
-    return vec4(h, mdf_ashikhmin(h.xy, h.z, ex, ey));
+    // D(h) = norm·hz^e with hz = exp(t): exp(e·t), without eq. 1's logarithm again.
+    return vec4(h, sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI * exp(e * t));
 }
 
 vec4 sample_projected_disc(vec2 u) {
