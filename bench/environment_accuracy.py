@@ -2,7 +2,7 @@
 brute-force reference of the same integral, and its time.
 
     OPALINE_ENVIRONMENTS_DIR=DIR python bench/environment_accuracy.py [--size 128]
-        [--environments studio pedestrian_overpass_1k.hdr] [--cases mirror glossy]
+        [--environments studio sky FILE.hdr] [--cases mirror glossy]
 
 The reference renders the material at the ``reference`` tier (64 samples, 32
 wavelengths) with the map read at full resolution for every sample (``brute``: no
@@ -11,7 +11,9 @@ it agrees with a render of half as many samples (the ``converged`` column, FLIP)
 tier then renders as a user gets it (its samples, wavelengths, environment samples,
 filtered importance sampling) and is compared with the reference on display images
 (bench/metrics.py: FLIP, CIEDE2000). Median-cut lights at the tier's K are measured
-beside it, the method they replace. Prints the table, writes
+beside it, the method they replace. ``grain`` is the image's mean |image − its 3×3
+box blur| over the object (display values, 0-1): what few lobe samples a pixel leave as
+speckle, beside the reference's own. Prints the table, writes
 bench/results/environment_accuracy.{md,json}.
 """
 
@@ -65,6 +67,16 @@ def render(local: LocalRenderer, fields: dict[str, Any], brute: bool = False
     return frame.display[..., :3], min(times)
 
 
+def grain(image: np.ndarray) -> float:
+    """Mean |image − 3×3 box blur| where the image is not the background (its corner's
+    colour: the sphere does not reach the corners)."""
+    padded = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    blur = sum(padded[i:i + image.shape[0], j:j + image.shape[1]]
+               for i in range(3) for j in range(3)) / 9.0
+    covered = np.abs(image - image[0, 0]).max(-1) > 1e-6
+    return float(np.abs(image - blur)[covered].mean()) if covered.any() else 0.0
+
+
 def measure(local: LocalRenderer, case: str, environment: str, size: int, samples: int
             ) -> list[dict[str, Any]]:
     base = dict(preset="sphere", width=size, height=size, environment=environment, kd=0.0,
@@ -89,7 +101,8 @@ def measure(local: LocalRenderer, case: str, environment: str, size: int, sample
             rows.append({"case": case, "environment": environment, "tier": tier,
                          "method": method, "ms": seconds * 1e3, "ref_s": ref_s,
                          "converged_flip": converged, **all_metrics(reference, image),
-                         "lighting_flip": all_metrics(own, image)["flip"]})
+                         "lighting_flip": all_metrics(own, image)["flip"],
+                         "grain": grain(image), "reference_grain": grain(reference)})
             print(json.dumps(rows[-1]), flush=True)
     return rows
 
@@ -100,13 +113,14 @@ def table(rows: list[dict[str, Any]], size: int, samples: int) -> str:
              "samples per pixel; `converged` is its FLIP against half as many. Command: "
              "`python bench/environment_accuracy.py`.", "",
              "| case | environment | tier | method | ms | FLIP | lighting FLIP | ΔE00 mean | "
-             "ΔE00 p95 | converged |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "ΔE00 p95 | grain (reference) | converged |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['case']} | {r['environment']} | {r['tier']} | {r['method']} | "
                      f"{r['ms']:.0f} | {r['flip']:.4f} | {r['lighting_flip']:.4f} | "
                      f"{r['de2000_mean']:.2f} | "
-                     f"{r['de2000_p95']:.2f} | {r['converged_flip']:.4f} |")
+                     f"{r['de2000_p95']:.2f} | {r['grain']:.4f} ({r['reference_grain']:.4f}) | "
+                     f"{r['converged_flip']:.4f} |")
     worst = {(t, m): max(r["flip"] for r in rows if r["tier"] == t and r["method"] == m)
              for t in TIERS for m in ("map", "lights")}
     lines += ["", "Worst FLIP over the cases: " + ", ".join(
@@ -117,9 +131,9 @@ def table(rows: list[dict[str, Any]], size: int, samples: int) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=int, default=128)
-    parser.add_argument("--environments", nargs="+", default=["studio"])
+    parser.add_argument("--environments", nargs="+", default=["studio", "sky"])
     parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
-    parser.add_argument("--reference-samples", type=int, default=4096)
+    parser.add_argument("--reference-samples", type=int, default=2048)
     args = parser.parse_args()
     rows: list[dict[str, Any]] = []
     with LocalRenderer() as local:

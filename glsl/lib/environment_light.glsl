@@ -119,87 +119,37 @@ vec3 environment_irradiance(Environment env, vec3 n) {
     return max(e, vec3(0.0)) * env.intensity;
 }
 
-#ifdef ENV_RGB_LOBES
-// The rotation source's map samples in the paper's own colour (eq. 2): one lobe for each
-// channel, turned by 0, θ1, θ2, the very lobes the mixture draws from (their values at
-// the sample, g_env_lobes, are its density's terms), so a sample's weight D_c/pdf stays
-// under 3. Set below 48 samples a pixel (gl/environment_light.py): there the
-// 16-wavelength colour cost 3× as much a sample and measured no closer to the spectral
-// brute-force reference (FLIP 0.106 either way at 6 samples), while the spectral lobe
-// is still what lights (the preset's, a map's bright features) evaluate.
-vec3 specular_rgb_lobes(Material mat, float vh, float nl, float nv) {
-    vec3 d = g_env_lobes;
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
-#else
-    float f = 1.0;
-#endif
-    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return mat.ks * d * (f / denom) * nl;
-}
-#endif
+#include "lib/environment_lobes.glsl"
 
-#ifdef ENV_ENVELOPE
-// The multi-peak lobe under an environment, D(λ, h) = ½·hz + ½·hz·band(λ, h). Float64
-// twin: opaline/model/envelope.py, which says why and what it measured.
-// * The envelope ½·hz, the same at every wavelength and as wide as the hemisphere: its
-//   albedo A(n·v) times the map's mean radiance about d = n + ½·r (normalised, r the
-//   mirror direction), the irradiance E(d)/π of the diffuse term's nine coefficients.
-// * The bands, which carry the colour: lobe samples, their spectrum shared among a
-//   pass's samples (sample i carries wavelengths i, i + ENV_SAMPLES, …: a pass costs one
-//   spectral evaluation, as one light does), each band box-filtered over the share of
-//   the disc its wavelength's samples stand for. None are drawn (ENV_SAMPLES 0) when
-//   that filter leaves them under 5 % of the envelope anywhere on the lobe.
-vec3 specular_bands(Material mat, vec3 hl, float vh, float nl, float nv, int first,
-                    float cell) {
-    vec3 d = vec3(0.0);
-    for (int i = first; i < WAVELENGTHS; i += max(ENV_SAMPLES, 1)) {
-        d += u_spectral_weight[i] * multipeak_band_cell(
-            rotate_half(real2(hl.xy), u_spectral_rotation[i]), mat.mu_f, mat.alpha, mat.beta, cell);
-    }
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
+// A lobe sample's weight, f(l, v)·(n·l)/pdf(l); hl the sampled half vector and ll the
+// light in the shading frame, i the sample's index in the pass (the bands' share).
+vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, vec3 ll,
+                       float pdf_l, int i, float cell, float film_nm) {
+    float vh = dot(vl, hl);
+#if defined(ENV_ENVELOPE)
+    return specular_bands(mat, hl, vh, ll.z, vl.z, i, cell) / pdf_l;
+#elif defined(ENV_RGB_LOBES)
+    return specular_rgb_lobes(mat, vh, ll.z, vl.z) / pdf_l;
+#elif defined(FILM_PER_PIXEL)
+    // Drawn from the film's own lobe, whose density is D(h): D/pdf is 1 and the lobe is
+    // not evaluated again, f·n·l/pdf_l = ks·film·n·l/max(n·l, n·v); the film comes in
+    // after the samples (environment_specular).
+    return vec3(mat.ks * ll.z / max(max(ll.z, vl.z), EPS_DENOM));
+#elif defined(IRIDESCENCE_THIN_FILM)
+    return mat.ks * film_colour(mat, vh, film_nm) * (ll.z / max(max(ll.z, vl.z), EPS_DENOM));
 #else
-    float f = 1.0;
-#endif
-    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return mat.ks * (0.5 * hl.z) * d * (f / denom) * nl;
-}
-
-// ∫ ½·hz·F/(4·v·h·max(n·l, n·v))·n·l dω: (π/8)·(2 − n·v), and with Schlick's F a fit to
-// its (1 − v·h)⁵ part (envelope.SCHLICK_FIT).
-float envelope_albedo(Material mat, float nv) {
-    float plain = PI / 8.0 * (2.0 - nv);
-#ifdef FRESNEL
-    float x = 1.0 - nv;
-    float schlick = ((((((1.42818824 * x - 3.31018136) * x + 3.11136970) * x - 1.31620555)
-                      * x + 0.267333428) * x - 0.0174354895) * x + 0.000192833728);
-    return mat.f0 * plain + (1.0 - mat.f0) * schlick;
-#else
-    return plain;
+    return specular(mat, frame, vec3(frame * real3(ll)), v, film_nm) * ll.z / pdf_l;
 #endif
 }
-
-vec3 specular_envelope(Material mat, Environment env, vec3 n, vec3 v) {
-    float nv = clamp(dot(n, v), 0.0, 1.0);
-    vec3 d = normalize(n + 0.5 * (2.0 * dot(n, v) * n - v));
-    return mat.ks * envelope_albedo(mat, nv) * environment_irradiance(env, d) / PI;
-}
-#endif
 
 vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
     vec3 vl = vec3(transpose(frame) * real3(v));
-#ifdef FILM_PER_PIXEL
-    // At the mirror direction's v·h = n·v: over a glossy lobe v·h hardly moves, and the
-    // film is most of a sample's cost (the Sample Viewer's split sum does the same).
-    g_film_colour = film_layer_rgb(mat.film, clamp(vl.z, 0.0, 1.0),
-                                   film_thickness_nm(mat.film, film_nm));
-#endif
     vec3 shift = env_pixel_shift();
-#ifdef ENV_ENVELOPE
-    // A wavelength's samples over the pixel: one a pass.
-    float cell = sqrt(PI * float(ENV_SAMPLES) / max(env.total, 1.0));
+#ifdef FILM_PER_PIXEL
+    vec2 film_at = vec2(0.0);  // Σ luminance·v·h, Σ luminance of the samples' light
 #endif
+    // The multi-peak bands' filter: a wavelength's samples over the pixel, one a pass.
+    float cell = sqrt(PI * float(ENV_SAMPLES) / max(env.total, 1.0));
     vec3 sum = vec3(0.0);
     for (int i = 0; i < ENV_SAMPLES; ++i) {
         vec3 u = env_sequence(env.pass * ENV_SAMPLES + i, shift);
@@ -217,22 +167,24 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
         }
         // Density of l: dω_h/dω_l = 1/(4 v·h), floored as the reflectance floors it.
         float pdf_l = s.w / (4.0 * max(vh, EPS_DENOM));
-        vec3 l = vec3(frame * real3(ll));
-#if defined(ENV_ENVELOPE)
-        vec3 weight = specular_bands(mat, s.xyz, vh, ll.z, vl.z, i, cell) / pdf_l;
-#elif defined(ENV_RGB_LOBES)
-        vec3 weight = specular_rgb_lobes(mat, vh, ll.z, vl.z) / pdf_l;
-#elif defined(IRIDESCENCE_THIN_FILM)
-        // Drawn from the film's own lobe, whose density is D(h): D/pdf is 1 and the lobe
-        // is not evaluated again, f·n·l/pdf_l = ks·film·n·l/max(n·l, n·v).
-        vec3 weight = mat.ks * film_colour(mat, vh, film_nm)
-                      * (ll.z / max(max(ll.z, vl.z), EPS_DENOM));
-#else
-        vec3 weight = specular(mat, frame, l, v, film_nm) * ll.z / pdf_l;
+        vec3 weight = env_sample_weight(mat, frame, v, vl, s.xyz, ll, pdf_l, i, cell, film_nm);
+        vec3 m = env_to_map(env, vec3(frame * real3(ll)));
+        vec3 light = env_lookup(env, m, env_lod(env, m, pdf_l)) * weight;
+        sum += light;
+#ifdef FILM_PER_PIXEL
+        float luminance = dot(light, vec3(0.2126, 0.7152, 0.0722));
+        film_at += vec2(luminance * vh, luminance);
 #endif
-        vec3 m = env_to_map(env, l);
-        sum += env_lookup(env, m, env_lod(env, m, pdf_l)) * weight;
     }
+#ifdef FILM_PER_PIXEL
+    // Once a pixel, at the v·h its light came from (the samples' mean, weighted by what
+    // each brought): over a glossy lobe that is n·v, over a broad one it follows the
+    // bright parts of the map. The map's bright features use this colour too.
+    float vh_film = film_at.y > 0.0 ? film_at.x / film_at.y : vl.z;
+    g_film_colour = film_layer_rgb(mat.film, clamp(vh_film, 0.0, 1.0),
+                                   film_thickness_nm(mat.film, film_nm));
+    sum *= g_film_colour;
+#endif
 #ifdef ENV_ENVELOPE
     // Each wavelength once a pass: the sum is the pass's estimate of the bands.
     return max(sum + specular_envelope(mat, env, vec3(frame[2]), v), vec3(0.0));
