@@ -170,54 +170,6 @@ def test_irradiance_of_a_users_constant_map(renderer, tmp_path):
     np.testing.assert_allclose(gl[:, :3], np.pi * 0.5, rtol=1e-3)
 
 
-MULTIPEAK = Material(mdf="multipeak", mu_f=8.5, alpha=2.0, beta=1.2, theta1=0.1, theta2=0.2,
-                     ks=0.7, kd=0.0)
-
-
-@pytest.mark.parametrize("f0", [1.0, 0.3], ids=["no-fresnel", "f0=0.3"])
-@pytest.mark.parametrize("rotation", [0.0, 2.0])
-def test_multipeak_envelope_agrees(renderer, f0, rotation):
-    """specular_envelope (the multi-peak lobe's envelope, ENV_ENVELOPE) is the twin's
-    ks·A(n·v)·E(d)/π, d = envelope.dominant(n, v) turned into the map's frame."""
-    from opaline.model import envelope
-
-    rng = np.random.default_rng(9)
-    n = rng.normal(size=(512, 3))
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
-    v = n + rng.normal(size=(512, 3)) * 0.8
-    v /= np.linalg.norm(v, axis=1, keepdims=True)
-    keep = (n * v).sum(1) > 0.02
-    n, v = as_f32(n[keep]), as_f32(v[keep])
-    mat = MULTIPEAK.model_copy(update={"f0": f0})
-    uploaded = renderer.environments.get("studio")
-    environment = (uploaded.texture, uploaded.irradiance)
-    gl = renderer.probes.lobe(mat, "envelope", (n, n, v), environment, rotation=rotation,
-                              samples=0, brute=False, wavelengths=16)[0][:, :3]
-    d = envelope.dominant(n.astype(np.float64), v.astype(np.float64))
-    c, s = math.cos(rotation), math.sin(rotation)
-    m = np.stack([c * d[:, 0] + s * d[:, 2], d[:, 1], c * d[:, 2] - s * d[:, 0]], -1)
-    nv = (n.astype(np.float64) * v).sum(1)
-    expected = (mat.ks * envelope.albedo(nv, f0)[:, None] * irr.irradiance(environment[1], m)
-                / math.pi)
-    assert np.isfinite(gl).all()
-    assert float(np.abs(gl - expected).max()) <= 1e-5 * float(expected.max())
-
-
-@pytest.mark.parametrize("cell", [0.0, 0.02, 0.3, 1.77])
-def test_multipeak_band_filter_agrees(renderer, cell):
-    """multipeak_band_cell is envelope.band_cell over the disc, to fp32's phase: the
-    phase is reduced to cycles' fraction before the cosine (|Δcos| ≤ 2π·mu_f·r·1.2e-7)."""
-    from opaline.model import envelope
-
-    u = np.random.default_rng(11).random((4096, 2))
-    r, phi = np.sqrt(u[:, 0]), TWO_PI * u[:, 1]
-    h = as_f32(np.stack([r * np.cos(phi), r * np.sin(phi), np.full_like(r, cell)], -1))
-    gl = renderer.probes.lobe(MULTIPEAK, "band_cell", (h, h[:, [2, 2, 2]]))[0][:, 0]
-    hx, hy = h[:, 0].astype(np.float64), h[:, 1].astype(np.float64)
-    expected = envelope.band_cell(hx, hy, 8.5, 2.0, 1.2, float(np.float32(cell)))
-    assert float(np.abs(gl - expected).max()) <= 2e-4
-
-
 @pytest.mark.parametrize("f0", [1.0, 0.2], ids=["no-fresnel", "f0=0.2"])
 def test_rotation_map_samples_in_rgb_are_the_papers_channels(renderer, f0):
     """With ENV_RGB_LOBES a spectral variant's map samples give what the paper's RGB

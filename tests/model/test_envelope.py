@@ -59,7 +59,8 @@ MATERIALS = [(8.5, 2.0, 1.2), (2.0, 1.0, 0.1), (30.0, 0.5, 3.0), (1.0, 0.0, 2.0)
 @pytest.mark.parametrize("per_wavelength", [1, 8, 64, 1024])
 def test_bound_holds_wherever_bands_are_dropped(mu_f, alpha, beta, per_wavelength):
     """Where ``bands_resolved`` says no, the filtered band is under BAND_FLOOR at every h of
-    the disc (checked on 250k points); where it says yes, the bound it used is above it."""
+    the disc (checked on 250k points). (Where it says yes the bound is merely above the
+    floor: it is a bound, and the bands may still be under it.)"""
     rng = np.random.default_rng(3)
     u = rng.random((250_000, 2))
     r, phi = np.sqrt(u[:, 0]), 2 * math.pi * u[:, 1]

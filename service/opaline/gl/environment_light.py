@@ -22,13 +22,14 @@ from opaline.model.environment_light import band_samples, splits_lobe
 from opaline.model.params import Material
 from opaline.model.request import Job
 
-# From this many samples a pixel, the film is evaluated at each sample's own v·h; below
-# (draft's 2, standard's 6), once at n·v; and the rotation source's map samples take the
-# spectral colour, below it the paper's three channels (environment_light.glsl). Measured against the brute-force reference
-# (bench/environment_accuracy.py, studio, 128²): once per pixel costs FLIP +0.000-0.005
-# at 2-4 samples, where it makes a standard-tier film 1.1-1.3× its key-lit time instead
-# of 2-2.8×, but leaves a floor near 0.01 that the high tier (64 samples, 0.003-0.006
-# exact) should not have.
+# From this many samples a pixel, the film is evaluated at each sample's own v·h, and the
+# rotation source's map samples take its spectral colour; below (draft's 2 and 3,
+# standard's 6 and 9), the film once a pixel at the v·h its light came from, and the
+# paper's three channels (glsl/lib/environment_light.glsl, docs/design.md §4.5). Against
+# the brute-force reference (bench/environment_accuracy.py, studio, 128², standard) the
+# film once a pixel measured FLIP 0.020 on a glossy film and 0.030-0.046 on broad ones,
+# at every sample 0.017-0.029 at two to three times the time; the three channels 0.106
+# against the spectrum's 0.106 at 6 samples, at half the time.
 FILM_PER_SAMPLE_FROM = 48
 
 
@@ -54,7 +55,11 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
                               and job.material.mdf == "ashikhmin" and job.wavelengths > 0
                               and not brute
                               and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
-            "LIGHT_COUNT": lights if lights else False}
+            "LIGHT_COUNT": lights if lights else False,
+            # A lobe sample's h is drawn anew in each pixel, so the pixel filter's screen
+            # derivative of the multi-peak phase at it means nothing: the brute-force
+            # reference reads the bands unfiltered (the split lobe filters its own).
+            **({"AA_ANALYTIC": False} if brute and job.material.mdf == "multipeak" else {})}
 
 
 def map_uniforms(texture: moderngl.Texture, irradiance: np.ndarray) -> Uniforms:

@@ -142,9 +142,14 @@ class Probes:
         source's map samples in the paper's three channels."""
         res = self.resources
         res.gl.make_current()
+        coloured_by_rotation = material.iridescence == "rotation"
+        if rgb_lobes and not (coloured_by_rotation and material.mdf == "ashikhmin"):
+            raise ValueError("rgb_lobes: only the rotation source's Ashikhmin-Shirley lobes")
         defines = {**material_program.material_defines(material, wavelengths),
                    "ENV_SAMPLES": samples, "ENV_BRUTE": brute,
-                   "ENV_ENVELOPE": wavelengths > 0 and material.mdf == "multipeak",
+                   # As the renderer decides (gl/environment_light.py), for one case.
+                   "ENV_ENVELOPE": (coloured_by_rotation and material.mdf == "multipeak"
+                                    and wavelengths > 0 and not brute),
                    "ENV_RGB_LOBES": rgb_lobes}
         program = res.programs.get("lobe_probe.glsl", defines)
         values = material_program.material_uniforms(material, wavelengths)

@@ -1,12 +1,14 @@
 """How a job's environment lights it, decided once for the renderer and for admission.
 
-The map is read for the rotation source (either MDF) and thin film, unless the request
-asks for lights (``environment_lights``). Ashikhmin-Shirley lobes and films draw lobe
-samples. The multi-peak lobe is split (``model/envelope.py``): its envelope from the
-map's irradiance, its bands from lobe samples sharing the spectrum, drawn only where
-the pixel's samples resolve them. A grating's orders are sharp lobes about directions
-the sampler does not know: it keeps median-cut lights, which measured closer to the
-brute-force reference (bench/environment_accuracy.py, docs/accuracy.md).
+The map is read for the rotation source and thin film, unless the request asks for
+lights (``environment_lights``). Ashikhmin-Shirley lobes and films draw lobe samples.
+The spectral multi-peak lobe is split (``model/envelope.py``): its envelope from the
+map's irradiance, its bands from lobe samples, drawn only where the pixel's samples
+resolve them. Median-cut lights stay for a grating, whose orders are sharp lobes about
+directions the sampler does not know (they measured closer to the brute-force
+reference, bench/environment_accuracy.py, docs/accuracy.md), and for the paper's RGB
+multi-peak lobe (wavelengths=0): the split's band samples share a spectrum, which the
+RGB path does not have.
 """
 
 from __future__ import annotations
@@ -24,33 +26,42 @@ WAVELENGTHS_PER_SAMPLE = 4
 
 
 def reads_map(job: Job) -> bool:
-    lobe_sampled = job.material.iridescence in ("thin-film", "rotation")
+    material = job.material
+    lobe_sampled = material.iridescence == "thin-film" or (
+        material.iridescence == "rotation"
+        and (material.mdf == "ashikhmin" or job.wavelengths > 0))
     return job.environment is not None and job.environment_lights is None and lobe_sampled
 
 
 def splits_lobe(job: Job) -> bool:
-    """Whether the lobe is the multi-peak one read as envelope and bands (spectral only:
-    the bands' samples share the wavelengths)."""
+    """Whether the lobe is the multi-peak one read as envelope and bands (spectral: a
+    pass's band samples share the wavelengths)."""
     material = job.material
-    return (reads_map(job) and material.iridescence == "rotation"
-            and material.mdf == "multipeak" and job.wavelengths > 0)
+    return reads_map(job) and material.iridescence == "rotation" and material.mdf == "multipeak"
 
 
 def band_samples(job: Job, per_pass: int) -> int:
-    """A pass's lobe samples for the multi-peak bands: none where one sample of each
-    wavelength a pass (job.samples over the pixel) cannot resolve them, else at most one
-    for every ``WAVELENGTHS_PER_SAMPLE`` wavelengths."""
+    """A pass's lobe samples for the multi-peak bands, each wavelength read by one of
+    them: none where one sample of each wavelength a pass (job.samples over the pixel)
+    cannot resolve them. In one pass, at most one for every ``WAVELENGTHS_PER_SAMPLE``
+    wavelengths, which spreads a wavelength's reads over directions; over several passes,
+    one a pass carrying every wavelength, which costs the same spectral evaluation and
+    keeps each wavelength's samples a contiguous run of the pixel's sequence (sample i of
+    every pass is every N-th point of it, bunched in radius: r² within 0.14 at N = 4)."""
     material = job.material
     if not bands_resolved(material.mu_f, material.alpha, material.beta, job.samples):
         return 0
+    if job.samples > 1:
+        return 1
     return max(1, min(per_pass, job.wavelengths // WAVELENGTHS_PER_SAMPLE))
 
 
 def light_equivalents(job: Job) -> int:
     """What one sample of the job shades, counted in lights: K median-cut lights, or a
-    sample's share of the lobe samples plus the bright features split off the map (each
-    lobe sample costs about one light: the reflectance is evaluated once for each; the
-    multi-peak bands' samples of a pass, one spectral evaluation together)."""
+    sample's share of the lobe samples plus the bright features split off the map (a
+    lobe sample costs at most about one light, the reflectance evaluated once for it,
+    and less where the film or the rotation's channels are shared; the multi-peak
+    bands' samples of a pass, one spectral evaluation together)."""
     if not reads_map(job):
         return job.environment_count
     per_pass = math.ceil(job.environment_sample_count / job.samples)

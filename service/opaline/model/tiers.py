@@ -43,9 +43,10 @@ class Tier:
     # Directions per pixel drawn from the material's lobe to read the environment map
     # (glsl/lib/environment_light.glsl), over all the tier's samples together.
     environment_samples: int
-    # The same for the rotation source's three Ashikhmin-Shirley lobes (a multiple of 3,
-    # each lobe its share): against the brute-force reference (studio, A-S 100×1000,
-    # θ 0.5/1.0) 6 left FLIP 0.106, 9 0.088, 12 0.079 (bench/environment_accuracy.py).
+    # The same for the rotation source's three Ashikhmin-Shirley lobes (at draft and
+    # standard a multiple of 3 a pass, so each lobe gets its third): against the
+    # brute-force reference (studio, A-S 100×1000, θ 0.5/1.0) 6 left FLIP 0.106, 9 0.088,
+    # 12 0.079 (bench/environment_accuracy.py).
     environment_samples_rotation: int
     measured: Measured | None = None  # quality=auto only
 
