@@ -44,22 +44,21 @@ def samples_per_pass(job: Job, samples: SamplePlan, brute: bool = False) -> int:
 def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             brute: bool = False) -> dict[str, int | bool]:
     lights = len(environment.light_directions)
+    material = job.material
+    # Few samples a pixel: the film's colour and the rotation's channels are shared.
+    shared = not brute and job.environment_sample_count < FILM_PER_SAMPLE_FROM
     return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples, brute),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
-            "FILM_PER_PIXEL": (job.material.iridescence == "thin-film" and not brute
-                               and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
-            # The same threshold for the rotation source's spectrum (environment_light.glsl).
-            "ENV_RGB_LOBES": (job.material.iridescence == "rotation"
-                              and job.material.mdf == "ashikhmin" and job.wavelengths > 0
-                              and not brute
-                              and job.environment_sample_count < FILM_PER_SAMPLE_FROM),
+            "FILM_PER_PIXEL": material.iridescence == "thin-film" and shared,
+            "ENV_RGB_LOBES": (material.iridescence == "rotation" and material.mdf == "ashikhmin"
+                              and job.wavelengths > 0 and shared),
             "LIGHT_COUNT": lights if lights else False,
             # A lobe sample's h is drawn anew in each pixel, so the pixel filter's screen
             # derivative of the multi-peak phase at it means nothing: the brute-force
             # reference reads the bands unfiltered (the split lobe filters its own).
-            **({"AA_ANALYTIC": False} if brute and job.material.mdf == "multipeak" else {})}
+            **({"AA_ANALYTIC": False} if brute and material.mdf == "multipeak" else {})}
 
 
 def map_uniforms(texture: moderngl.Texture, irradiance: np.ndarray) -> Uniforms:
