@@ -51,6 +51,10 @@ CASES: dict[str, dict[str, Any]] = {
     "bubble": dict(iridescence="thin-film", ex=4.0, ey=4.0, film_ior=1.33, substrate_ior=1.0,
                    film_thickness_min=0.0, film_thickness_max=1000.0),
     "multipeak": dict(),  # the sphere preset's own material
+    # A CD's grating with a lobe broad enough for the brute-force reference's disc
+    # samples to converge (the presets' 3000 x 30000 would need millions a pixel).
+    "grating": dict(iridescence="grating", mdf="ashikhmin", ex=100.0, ey=100.0,
+                    grating_pitch=1.6, grating_orders=3, grating_depth=150.0, f0=0.9),
 }
 TIERS = ("draft", "standard", "high")
 

@@ -22,8 +22,9 @@ uniform vec2 u_substrate_nk[WAVELENGTHS];
 #elif defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR)
 uniform vec2 u_substrate_nk[3];
 #endif
-#if WAVELENGTHS == 0 && defined(IRIDESCENCE_GRATING)
+#if (WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)) && defined(IRIDESCENCE_GRATING)
 uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
+uniform vec3 u_visible_cumulative[81];  // its integral from 380 nm (visible.cumulative_table)
 #endif
 #include "lib/material.glsl"
 
@@ -61,7 +62,7 @@ uniform float u_film_weight;
 #ifdef IRIDESCENCE_GRATING
 uniform float u_grating_pitch_nm;
 uniform float u_grating_depth_nm;
-#if WAVELENGTHS == 0
+#if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
 uniform vec3 u_channel_nm;
 #endif
 #endif
@@ -109,7 +110,7 @@ Material material_params() {
 #ifdef IRIDESCENCE_GRATING
     mat.grating.pitch_nm = u_grating_pitch_nm;
     mat.grating.depth_nm = u_grating_depth_nm;
-#if WAVELENGTHS == 0
+#if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
     mat.grating.channel_nm = u_channel_nm;
 #endif
 #endif

@@ -15,6 +15,8 @@
 // (a sampler cannot be a member of a struct variable).
 #ifndef ENVIRONMENT_LIGHT_GLSL
 #define ENVIRONMENT_LIGHT_GLSL
+// A grating order's read at the level whose texel spans its footprint, less this.
+#define ENV_FOOTPRINT_BIAS -1.0
 #include "lib/reflectance.glsl"
 #include "lib/lobe_sampling.glsl"
 
@@ -43,19 +45,35 @@ vec3 env_lookup(Environment env, vec3 m, float lod) {
     return textureLod(u_env_map, uv, lod).rgb * env.intensity;
 }
 
-// The level whose texel spans 1/(N·pdf): a level-0 texel spans (2π/W)(π/H)·cos(elevation).
+// log2 of the side of a solid angle in level-0 texels toward m: a level-0 texel spans
+// (2π/W)(π/H)·cos(elevation).
+float env_texels_log2(Environment env, vec3 m, float solid_angle) {
+    float texel = TWO_PI * PI / (env.size.x * env.size.y)
+                  * max(sqrt(max(1.0 - m.y * m.y, 0.0)), 0.5 / env.size.y);
+    return 0.5 * log2(max(solid_angle, 1e-30) / texel);
+}
+
+// The level whose texel spans a lobe sample's share 1/(N·pdf).
 float env_lod(Environment env, vec3 m, float pdf_l) {
 #ifdef ENV_BRUTE
     return 0.0;
 #else
-    float texel = TWO_PI * PI / (env.size.x * env.size.y)
-                  * max(sqrt(max(1.0 - m.y * m.y, 0.0)), 0.5 / env.size.y);
-    float share = 1.0 / max(env.total * pdf_l, 1e-30);
     // Colbert & Křivánek add 1 (a sample's footprint is wider than its share) for ~40
     // samples; at the tiers' 2-64 a trilinear read of that level is wider than the lobe
     // itself. Measured against the brute-force reference (bench/environment_accuracy.py),
     // FLIP is least at -2 for every tier, map and lobe tried (docs/accuracy.md).
-    return clamp(0.5 * log2(share / texel) - 2.0, 0.0, env.max_lod);
+    return clamp(env_texels_log2(env, m, 1.0 / max(env.total * pdf_l, 1e-30)) - 2.0,
+                 0.0, env.max_lod);
+#endif
+}
+
+// The level whose texel spans a read's whole footprint (a grating's order); level 0 in
+// ENV_BRUTE (which only glsl/lobe_probe.glsl compiles with a grating's orders).
+float env_lod_footprint(Environment env, vec3 m, float solid_angle) {
+#ifdef ENV_BRUTE
+    return 0.0;
+#else
+    return clamp(env_texels_log2(env, m, solid_angle) + ENV_FOOTPRINT_BIAS, 0.0, env.max_lod);
 #endif
 }
 
@@ -91,8 +109,8 @@ vec3 g_env_lobes;
 // A half vector from the lobe and the density of the whole mixture there.
 vec4 env_sample_half(Material mat, Environment env, vec3 u) {
 #if defined(MDF_MULTIPEAK) || defined(IRIDESCENCE_GRATING)
-    // A grating's orders lie away from the mirror direction: only its brute-force
-    // reference reads the map, through the envelope as the multi-peak lobe does.
+    // A grating's orders lie away from the mirror direction: its brute-force reference
+    // samples the whole disc, and a render reads its orders (ENV_GRATING_ORDERS).
     return sample_projected_disc(u.xy);
 #elif defined(IRIDESCENCE_THIN_FILM)
     return sample_ashikhmin(u.xy, mat.ex, mat.ey);
@@ -120,6 +138,9 @@ vec3 environment_irradiance(Environment env, vec3 n) {
 }
 
 #include "lib/environment_lobes.glsl"
+#ifdef ENV_GRATING_ORDERS
+#include "lib/environment_grating.glsl"
+#endif
 
 // A lobe sample's weight, f(l, v)·(n·l)/pdf(l); hl the sampled half vector and ll the
 // light in the shading frame, i the sample's index in the pass (the bands' share).
@@ -143,6 +164,9 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 }
 
 vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
+#ifdef ENV_GRATING_ORDERS
+    return environment_grating(mat, env, frame, v);
+#else
     vec3 vl = vec3(transpose(frame) * real3(v));
     vec3 shift = env_pixel_shift();
 #ifdef FILM_PER_PIXEL
@@ -190,6 +214,7 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
     return max(sum + specular_envelope(mat, env, vec3(frame[2]), v), vec3(0.0));
 #else
     return sum / float(ENV_SAMPLES);
+#endif
 #endif
 }
 

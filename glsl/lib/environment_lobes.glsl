@@ -16,13 +16,7 @@
 // is still what lights (the preset's, a map's bright features) evaluate.
 vec3 specular_rgb_lobes(Material mat, float vh, float nl, float nv) {
     vec3 d = g_env_lobes;
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
-#else
-    float f = 1.0;
-#endif
-    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return mat.ks * d * (f / denom) * nl;
+    return mat.ks * d * microfacet_factor(mat, vh, nl, nv) * nl;
 }
 #endif
 
@@ -44,13 +38,7 @@ vec3 specular_bands(Material mat, vec3 hl, float vh, float nl, float nv, int fir
         d += u_spectral_weight[i] * multipeak_band_cell(
             rotate_half(real2(hl.xy), u_spectral_rotation[i]), mat.mu_f, mat.alpha, mat.beta, cell);
     }
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
-#else
-    float f = 1.0;
-#endif
-    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return mat.ks * (0.5 * hl.z) * d * (f / denom) * nl;
+    return mat.ks * (0.5 * hl.z) * d * microfacet_factor(mat, vh, nl, nv) * nl;
 }
 
 // ∫ ½·hz·F/(4·v·h·max(n·l, n·v))·n·l dω: (π/8)·(2 − n·v), and with Schlick's F a fit to

@@ -21,14 +21,20 @@
 #elif GRATING_ORDERS > 8
 #error "GRATING_ORDERS is at most 8"
 #endif
-#define BESSEL_TERMS 16
+// BESSEL_TERMS (2-16), the series' length the grooves' depth needs (grating.bessel_terms).
+#ifndef BESSEL_TERMS
+#error "define BESSEL_TERMS"
+#elif BESSEL_TERMS > 16
+#error "BESSEL_TERMS is at most 16"
+#endif
 #define EPS_K2 1e-12
 #define VISIBLE_TABLE 81  // glsl/material_params.glsl declares the table at this size
 
 // J_m(x) by its power series (x/2)^m/m! · Σ_k (-x²/4)^k·m!/(k!(k+m)!), summed by
 // Horner from the last term: a fixed count, no early exit, so it unrolls into
-// multiply-adds. Truncation < 1e-9 absolute for x ≤ 7 (depth ≤ 400 nm, λ ≥ 380 nm: x ≤
-// 6.6); fp32 cancellation among the terms loses < 1e-5 absolute there.
+// multiply-adds. Truncation < 1e-9 absolute at the depth's largest x (16 terms reach
+// x ≤ 7: depth ≤ 400 nm, λ ≥ 380 nm); fp32 cancellation among the terms loses < 1e-5
+// absolute there.
 float bessel_j(int m, float x) {
     float half_x = 0.5 * x;
     float lead = 1.0;
@@ -54,12 +60,7 @@ float order_lobe(Material mat, vec3 k, vec3 vl, float cos_max) {
     float k_len = sqrt(k2);
     vec3 h = k / k_len;
     float vh = dot(vl, h);
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
-#else
-    float f = 1.0;
-#endif
-    return f * mdf_ashikhmin(h.xy, h.z, mat.ex, mat.ey) * max(vh, 0.0) / (k2 * cos_max);
+    return material_fresnel(mat, vh) * mdf_ashikhmin(h.xy, h.z, mat.ex, mat.ey) * max(vh, 0.0) / (k2 * cos_max);
 }
 
 #if WAVELENGTHS > 0
@@ -74,7 +75,7 @@ float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, 
 // Σ_i w_i Σ_{|m| ≤ M} η_m(λ_i)·lobe_m(λ_i). The orders are written out, not looped:
 // with m a literal the Bessel series' divisors are constants (a loop over m this
 // large is not unrolled by Mesa, and its divisions cost a quarter of the draw).
-vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
+vec3 grating_color_spectral(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
     float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
     for (int i = 0; i < WAVELENGTHS; ++i) {
@@ -107,10 +108,15 @@ vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     }
     return max(sum, vec3(0.0));
 }
-#else
-// Fast path: each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999),
+#endif
+
+#if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
+// Fast path (and every grating under an environment read from its map, whose
+// orders are read in closed form over the spectrum too: lib/environment_grating.glsl):
+// each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999),
 // the lobe's extent in λ integrated under a Gaussian approximation across the
-// grooves: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey).
+// grooves: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey), the colour weight averaged
+// over the box of the same variance (Float64 twin: grating.grating_fast).
 vec3 visible_density(float lam) {
     float x = (lam - 380.0) / 5.0;
     if (!(x >= 0.0 && x <= float(VISIBLE_TABLE - 1))) {
@@ -120,7 +126,22 @@ vec3 visible_density(float lam) {
     return mix(u_visible_density[i], u_visible_density[i + 1], x - float(i));
 }
 
-vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
+// ∫ ŵ(λ) dλ from 380 nm to lam: the cumulative table, linear between its 5 nm points.
+vec3 visible_cumulative(float lam) {
+    float x = clamp((lam - 380.0) / 5.0, 0.0, float(VISIBLE_TABLE - 1));
+    int i = min(int(floor(x)), VISIBLE_TABLE - 2);
+    return mix(u_visible_cumulative[i], u_visible_cumulative[i + 1], x - float(i));
+}
+
+// ŵ averaged over lam ± half (a lobe's extent in λ); the density itself under half a step.
+vec3 visible_filtered(float lam, float half_nm) {
+    if (half_nm < 2.5) {
+        return visible_density(lam);
+    }
+    return (visible_cumulative(lam + half_nm) - visible_cumulative(lam - half_nm)) / (2.0 * half_nm);
+}
+
+vec3 grating_color_visible(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 k0 = vec3(k.x, 0.0, k.z);
     float base = order_lobe(mat, k0, vl, cos_max);
     float k0_len = sqrt(max(dot(k0, k0), EPS_K2));
@@ -128,15 +149,17 @@ vec3 grating_color(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
     for (int m = 1; m <= GRATING_ORDERS; ++m) {
         float spread = mat.grating.pitch_nm / float(m) * k0_len * width;
+        // The colour over the lobe's extent in λ: the box of the Gaussian's variance.
+        float half_nm = sqrt(3.0) * mat.grating.pitch_nm / float(m) * k0_len / sqrt(max(mat.ey, 1.0));
         for (int sign = -1; sign <= 1; sign += 2) {
             float lam = float(sign) * mat.grating.pitch_nm * k.y / float(m);
-            vec3 density = visible_density(lam);
-            // Outside the visible range the order has no colour (and the Bessel
-            // series would overflow float at the huge a of a tiny λ).
-            if (density == vec3(0.0)) {
-                continue;
+            if (lam + half_nm <= 380.0 || lam - half_nm >= 780.0) {
+                continue;  // outside the visible range (and its lobe's reach): no colour
             }
-            sum += density * (spread * grating_efficiency(m, lam, k.z, mat.grating.depth_nm) * base);
+            vec3 density = visible_filtered(lam, half_nm);
+            // η held in the visible range (a tiny λ would overflow the Bessel series).
+            float eta = grating_efficiency(m, clamp(lam, 380.0, 780.0), k.z, mat.grating.depth_nm);
+            sum += density * (spread * eta * base);
         }
     }
     float zero = order_lobe(mat, k, vl, cos_max);
@@ -153,7 +176,11 @@ vec3 grating_specular(Material mat, realmat3 frame, vec3 l, vec3 v) {
     vec3 vl = vec3(transpose(frame) * real3(v));
     float nl = float(dot(frame[2], real3(l)));
     float cos_max = max(max(nl, vl.z), EPS_DENOM);
-    return grating_color(mat, k, vl, cos_max);
+#if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
+    return grating_color_visible(mat, k, vl, cos_max);
+#else
+    return grating_color_spectral(mat, k, vl, cos_max);
+#endif
 }
 
 #endif

@@ -39,7 +39,7 @@ struct Film {  // lib/thin_film.glsl
 struct Grating {  // lib/grating.glsl
     float pitch_nm;
     float depth_nm;
-#if WAVELENGTHS == 0
+#if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
     vec3 channel_nm;  // where η_0 is taken per channel
 #endif
 };
@@ -98,5 +98,19 @@ vec3 mdf_color(Material mat, real2 h, float hz) {
         mdf(mat, rotate_half(h, mat.rotation[2]), hz));
 }
 #endif
+
+// Schlick's F where the material has it (FRESNEL), else 1.
+float material_fresnel(Material mat, float cos_theta) {
+#ifdef FRESNEL
+    return fresnel_schlick(cos_theta, mat.f0);
+#else
+    return 1.0;
+#endif
+}
+
+// F(v·h)/(4·(v·h)·max(n·l, n·v)): the microfacet reflectance of §1.5 without D and ks.
+float microfacet_factor(Material mat, float vh, float nl, float nv) {
+    return material_fresnel(mat, vh) / (4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM));
+}
 
 #endif

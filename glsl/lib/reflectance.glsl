@@ -49,13 +49,7 @@ vec3 specular(Material mat, realmat3 frame, vec3 l, vec3 v, float film_nm) {
 #endif
     float nl = float(dot(frame[2], real3(l)));
     float nv = float(dot(frame[2], real3(v)));
-#ifdef FRESNEL
-    float f = fresnel_schlick(vh, mat.f0);
-#else
-    float f = 1.0;
-#endif
-    float denom = 4.0 * max(vh, EPS_DENOM) * max(max(nl, nv), EPS_DENOM);
-    return mat.ks * d * (f / denom);
+    return mat.ks * d * microfacet_factor(mat, vh, nl, nv);
 #endif
 }
 

@@ -31,7 +31,7 @@ SOURCES = {
     "rotation-ashikhmin-1e6": dict(mdf="ashikhmin", ex=1e6, ey=1e6, kd=0.0),
     "rotation-multipeak": dict(mdf="multipeak", kd=0.2),
     "thin-film": dict(iridescence="thin-film", ex=500.0, ey=500.0),
-    "grating": dict(iridescence="grating"),  # median-cut lights from the same map
+    "grating": dict(iridescence="grating"),  # its orders read along their curve
 }
 # A lobe sample's weight f·cos/pdf is at most ks·3 for the rotation mixture (one lobe
 # over the three lobes' mean) and ks·π for the disc (D ≤ hz); a thin film's reflectance

@@ -18,7 +18,8 @@ from opaline.gl import texture_units
 from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
-from opaline.model.environment_light import band_samples, splits_lobe
+from opaline.model import grating, visible
+from opaline.model.environment_light import band_samples, reads_orders, splits_lobe
 from opaline.model.params import Material
 from opaline.model.request import Job
 
@@ -34,11 +35,23 @@ FILM_PER_SAMPLE_FROM = 48
 
 
 def samples_per_pass(job: Job, samples: SamplePlan, brute: bool = False) -> int:
-    """A pass's lobe samples; the multi-peak lobe's band samples where it is split (never
-    in the brute-force reference, which samples the whole lobe)."""
-    per_pass_pixels = samples.passes * samples.factor * samples.factor
-    per_pass = max(1, -(-job.environment_sample_count // per_pass_pixels))
+    """A pass's lobe samples; the multi-peak lobe's band samples where it is split, none
+    where a grating's orders are read (never in the brute-force reference, which samples
+    the whole lobe)."""
+    if reads_orders(job) and not brute:
+        return 0
+    per_pass = _per_pass(job, samples)
     return band_samples(job, per_pass) if splits_lobe(job) and not brute else per_pass
+
+
+def _per_pass(job: Job, samples: SamplePlan) -> int:
+    per_pass_pixels = samples.passes * samples.factor * samples.factor
+    return max(1, -(-job.environment_sample_count // per_pass_pixels))
+
+
+def grating_reads(job: Job, samples: SamplePlan, brute: bool = False) -> int:
+    """A pass's reads along the curve a grating's orders leave by (0: not read so)."""
+    return _per_pass(job, samples) if reads_orders(job) and not brute else 0
 
 
 def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
@@ -51,6 +64,8 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
+            "ENV_GRATING_ORDERS": reads_orders(job) and not brute,
+            "ENV_GRATING_READS": grating_reads(job, samples, brute) or False,
             "FILM_PER_PIXEL": material.iridescence == "thin-film" and shared,
             "ENV_RGB_LOBES": (material.iridescence == "rotation" and material.mdf == "ashikhmin"
                               and job.wavelengths > 0 and shared),
@@ -68,6 +83,14 @@ def map_uniforms(texture: moderngl.Texture, irradiance: np.ndarray) -> Uniforms:
             "u_env_size": (float(width), float(height)),
             "u_env_max_lod": float(math.floor(math.log2(max(width, height)))),
             "u_env_sh": [tuple(map(float, c)) for c in irradiance]}
+
+
+def grating_uniforms() -> Uniforms:
+    """The spectrum in closed form, which a grating's orders and lights are weighted by
+    under an environment read from its map, whatever the job's wavelengths."""
+    return {"u_visible_density": [tuple(row) for row in visible.density_table()[1]],
+            "u_visible_cumulative": [tuple(row) for row in visible.cumulative_table()],
+            "u_channel_nm": tuple(float(x) for x in grating.channel_wavelengths())}
 
 
 def lobe_rotations(material: Material) -> list[tuple[float, float]]:
@@ -89,6 +112,8 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
     }
+    if reads_orders(job) and not brute:
+        values.update(grating_uniforms())
     if len(environment.light_directions):
         # The map turns by +rotation about +y (atan2(z, x) grows): its lights with it.
         c, s = math.cos(rotation), math.sin(rotation)

@@ -62,8 +62,10 @@ def _physical_defines(material: Material) -> Defines:
         "MDF_MULTIPEAK": False,
         "AA_ANALYTIC": False,
         "FRESNEL": not thin_film and material.f0 < 1.0,
-        # A define so the order and Bessel loops unroll (glsl/lib/grating.glsl).
+        # Defines so the order and Bessel loops unroll (glsl/lib/grating.glsl), the series
+        # no longer than the grooves' depth needs.
         "GRATING_ORDERS": False if thin_film else material.grating_orders,
+        "BESSEL_TERMS": False if thin_film else grating.bessel_terms(material.grating_depth),
     }
 
 
@@ -172,5 +174,6 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
         values["u_film_sens_centre"] = [tuple(g) for g in gaussians[..., 1]]
         values["u_film_sens_sigma"] = [tuple(g) for g in gaussians[..., 2]]
         values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
+        values["u_visible_cumulative"] = [tuple(row) for row in visible.cumulative_table()]
         values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
     return values

@@ -131,7 +131,7 @@ class Probes:
              environment: tuple[moderngl.Texture, np.ndarray] | None = None,
              rotation: float = 0.0, intensity: float = 1.0, samples: int = 1,
              passes: int = 1, brute: bool = True, wavelengths: int = 0,
-             rgb_lobes: bool = False) -> np.ndarray:
+             rgb_lobes: bool = False, grating_reads: int = 0) -> np.ndarray:
         """glsl/lobe_probe.glsl for each case (up to three (count, 3) inputs, see its
         modes in ``LOBE_MODES``): (passes, count, 4), pass k continuing the pixel's
         sequence as the surface's passes do. ``environment``: the map's texture and
@@ -139,7 +139,8 @@ class Probes:
         ``brute`` level 0 always (else the filtered read, for ``samples · passes`` in all);
         ``wavelengths`` > 0: the spectral variant, split into envelope and bands where the
         lobe is the multi-peak one (model/envelope.py); ``rgb_lobes``: the rotation
-        source's map samples in the paper's three channels."""
+        source's map samples in the paper's three channels; ``grating_reads``: a
+        grating's orders read along their curve, that many reads a pass (brute: level 0)."""
         res = self.resources
         res.gl.make_current()
         coloured_by_rotation = material.iridescence == "rotation"
@@ -150,7 +151,9 @@ class Probes:
                    # As the renderer decides (gl/environment_light.py), for one case.
                    "ENV_ENVELOPE": (coloured_by_rotation and material.mdf == "multipeak"
                                     and wavelengths > 0 and not brute),
-                   "ENV_RGB_LOBES": rgb_lobes}
+                   "ENV_RGB_LOBES": rgb_lobes,
+                   "ENV_GRATING_ORDERS": grating_reads > 0,
+                   "ENV_GRATING_READS": grating_reads or False}
         program = res.programs.get("lobe_probe.glsl", defines)
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,
@@ -160,6 +163,8 @@ class Probes:
             texture, sh = environment
             texture.use(location=texture_units.ENVIRONMENT)
             values.update(environment_light.map_uniforms(texture, sh))
+        if grating_reads:
+            values.update(environment_light.grating_uniforms())
         values.update({"u_case_" + "abc"[unit]: unit for unit in range(len(cases))})
         results = []
         with case_textures(res, cases):

@@ -4,11 +4,11 @@ The map is read for the rotation source and thin film, unless the request asks f
 lights (``environment_lights``). Ashikhmin-Shirley lobes and films draw lobe samples.
 The spectral multi-peak lobe is split (``model/envelope.py``): its envelope from the
 map's irradiance, its bands from lobe samples, drawn only where the pixel's samples
-resolve them. Median-cut lights stay for a grating, whose orders are sharp lobes about
-directions the sampler does not know (they measured closer to the brute-force
-reference, bench/environment_accuracy.py, docs/accuracy.md), and for the paper's RGB
-multi-peak lobe (wavelengths=0): the split's band samples share a spectrum, which the
-RGB path does not have.
+resolve them. A spectral grating's orders are read where they leave
+(``model/grating_environment.py``): sharp lobes about directions the lobe sampler does
+not know. Median-cut lights stay for the RGB fast paths (wavelengths=0) of the grating,
+whose orders are placed by wavelength, and of the multi-peak lobe, whose split's band
+samples share a spectrum.
 """
 
 from __future__ import annotations
@@ -27,10 +27,16 @@ WAVELENGTHS_PER_SAMPLE = 4
 
 def reads_map(job: Job) -> bool:
     material = job.material
-    lobe_sampled = material.iridescence == "thin-film" or (
-        material.iridescence == "rotation"
-        and (material.mdf == "ashikhmin" or job.wavelengths > 0))
-    return job.environment is not None and job.environment_lights is None and lobe_sampled
+    from_map = material.iridescence == "thin-film" or (
+        material.iridescence == "rotation" and material.mdf == "ashikhmin") or (
+        job.wavelengths > 0 and material.iridescence in ("rotation", "grating"))
+    return job.environment is not None and job.environment_lights is None and from_map
+
+
+def reads_orders(job: Job) -> bool:
+    """Whether the map is read where a grating's orders leave, one read an order and
+    wavelength, instead of through lobe samples."""
+    return reads_map(job) and job.material.iridescence == "grating"
 
 
 def splits_lobe(job: Job) -> bool:
@@ -64,6 +70,8 @@ def light_equivalents(job: Job) -> int:
     bands' samples of a pass, one spectral evaluation together)."""
     if not reads_map(job):
         return job.environment_count
+    if reads_orders(job):
+        return 1 + MAX_LIGHTS  # every order's read, as one light evaluates every order
     per_pass = math.ceil(job.environment_sample_count / job.samples)
     if splits_lobe(job):
         return min(1, band_samples(job, per_pass)) + MAX_LIGHTS

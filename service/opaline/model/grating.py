@@ -35,12 +35,13 @@ from opaline.model.microfacet import (
     fresnel_schlick,
     mdf_ashikhmin,
 )
-from opaline.model.spectrum import rgb_weights, sample_wavelengths
+from opaline.model.spectrum import RANGE_NM, rgb_weights, sample_wavelengths
 
 if TYPE_CHECKING:
     from opaline.model.params import Material
 
 BESSEL_TERMS = 24  # series terms: below 1e-9 of the sum for a ≤ 7 (depth ≤ 400 nm)
+SHADER_BESSEL_TERMS = 16  # the shader's most: truncation below 1e-9 for a ≤ 7
 EPS_K2 = 1e-12
 
 
@@ -55,6 +56,19 @@ def bessel_j(m: int, x: npt.ArrayLike) -> FloatArray:
         term = term * q / (k * (k + m))
         total = total + term
     return total
+
+
+def bessel_terms(depth_nm: float) -> int:
+    """The terms the shader sums J_m's series to (its BESSEL_TERMS define): the fewest
+    whose first left out, (a/2)^2k/k!², is under 1e-9 at the largest a this depth reaches,
+    π·depth·2/380 nm (n·(l+v) ≤ 2, λ ≥ 380 nm); 16 at the deepest grooves (a ≤ 6.6).
+    A shallow groove's series is short: 9 terms at the CD's 150 nm, about half the cost."""
+    half_x = math.pi * depth_nm * 2.0 / 380.0 / 2.0
+    term, k = 1.0, 0
+    while term >= 1e-9 and k < SHADER_BESSEL_TERMS:
+        k += 1
+        term *= half_x * half_x / (k * k)
+    return max(k, 2)
 
 
 def efficiency(m: int, lam_nm: Values, depth_nm: float, kn: FloatArray) -> FloatArray:
@@ -121,9 +135,11 @@ def grating_fast(material: Material, frame: Frame, l: FloatArray, v: FloatArray)
     """Each order straight at its wavelength λ_m = d·(l+v)·b/m (Stam 1999's idea).
 
     The lobe's extent in λ is integrated in closed form under a Gaussian
-    approximation of the A-S lobe across the grooves, exp(-ey·h_b²/2), with the
-    colour weight taken constant over it: ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey).
-    Right for lobes narrower than the visible range (ey ≳ 1e3 on a CD)."""
+    approximation of the A-S lobe across the grooves, exp(-ey·h_b²/2):
+    ∫ D dλ ≈ D(h at k_b = 0)·(d/|m|)·|k_0|·√(2π/ey), the colour weight averaged over the
+    box of the same variance, λ ± √3·(d/|m|)·|k_0|/√ey. A broad lobe's orders so blend
+    toward white as the spectral path's do, where a point read of the weight kept them
+    pure spectral colours."""
     kt, kb, kn = _local(frame, l + v)
     vt, _, vn = _local(frame, v)
     ln = _local(frame, l)[2]
@@ -140,10 +156,12 @@ def grating_fast(material: Material, frame: Frame, l: FloatArray, v: FloatArray)
         for sign in (1, -1):
             lam = sign * pitch_nm * kb / m
             spread = (pitch_nm / m) * k0 * math.sqrt(2.0 * math.pi / max(material.ey, 1.0))
-            density = visible.density_at(lam)
-            # Outside the visible range: no colour, and no Bessel series at a huge a.
-            eta = efficiency(m, np.where(np.any(density != 0.0, axis=-1), lam, 550.0),
-                             material.grating_depth, kn_pos)
+            # The colour over the lobe's extent in λ: the box of the Gaussian's variance.
+            half = math.sqrt(3.0) * (pitch_nm / m) * k0 / math.sqrt(max(material.ey, 1.0))
+            density = visible.filtered_density(lam, half)
+            # η held in the visible range: outside it the colour is 0 (or the lobe's
+            # reach into it), and a tiny λ would overflow the Bessel series.
+            eta = efficiency(m, np.clip(lam, *RANGE_NM), material.grating_depth, kn_pos)
             total = total + density * (spread * eta * base)[..., None]
     zero = order_lobe(material, frame, l, v, 0, 550.0)  # m = 0: k does not depend on λ
     eta0 = np.stack(

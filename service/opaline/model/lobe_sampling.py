@@ -71,3 +71,20 @@ def sequence(k: npt.ArrayLike, shift: npt.ArrayLike = (0.0, 0.0, 0.0)) -> FloatA
     n = np.asarray(k, dtype=np.float64)[..., None] + 0.5
     result: FloatArray = np.mod(np.asarray(shift) + n * R2, 1.0)
     return result
+
+
+def pixel_shift(x: npt.ArrayLike, y: npt.ArrayLike) -> FloatArray:
+    """A pixel's shift of its sequence, from an integer hash of its coordinates, as
+    ``env_pixel_shift`` in glsl/lib/environment_light.glsl: (..., 3) in [0, 1)."""
+    def mix(h: np.ndarray) -> np.ndarray:
+        mixed: np.ndarray = ((h ^ (h >> 16)) * np.uint64(0x45D9F3B)) & np.uint64(0xFFFFFFFF)
+        return mixed
+
+    h = (np.asarray(x, dtype=np.uint64) * np.uint64(1973) + np.asarray(y, dtype=np.uint64)
+         * np.uint64(9277) + np.uint64(26699)) & np.uint64(0xFFFFFFFF)
+    h = mix(mix(h))
+    h ^= h >> 16
+    result: FloatArray = np.stack([(h & np.uint64(1023)).astype(np.float64) / 1024.0,
+                                   ((h >> 10) & np.uint64(1023)).astype(np.float64) / 1024.0,
+                                   (h >> 20).astype(np.float64) / 4096.0], axis=-1)
+    return result

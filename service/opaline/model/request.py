@@ -79,12 +79,15 @@ class Job:
 
     @property
     def environment_sample_count(self) -> int:
-        """Lobe samples per pixel that read the environment map, the job's or its tier's."""
+        """Lobe samples (a grating: reads of its orders' curve) per pixel that read the
+        environment map, the job's or its tier's."""
         if self.environment_samples:
             return self.environment_samples
         material = self.material
         if material.iridescence == "rotation" and material.mdf == "ashikhmin":
             return self.tier.environment_samples_rotation
+        if material.iridescence == "grating":
+            return self.tier.environment_samples_grating
         return self.tier.environment_samples
 
     @property

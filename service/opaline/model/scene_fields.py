@@ -71,20 +71,23 @@ class SceneFields(BaseModel):
         None, description="Multiplies the environment's radiance, 0 … 1000 (default 1).")
     environment_lights: Annotated[int, Field(ge=1, le=256)] | None = Field(
         None, description="K: light the scene with the environment as K directional lights "
-                          "by median cut instead of reading the map, 1 … 256 (a grating and "
-                          "the RGB multi-peak lobe, wavelengths=0, always do, by default with "
-                          "the tier's K: draft 8, standard 16, high 32, reference 64).")
+                          "by median cut instead of reading the map, 1 … 256 (the RGB paths, "
+                          "wavelengths=0, of a grating and of the multi-peak lobe always do, "
+                          "by default with the tier's K: draft 8, standard 16, high 32, "
+                          "reference 64).")
     environment_samples: Annotated[int, Field(ge=1, le=4096)] | None = Field(
         None, description="Directions drawn from the material's lobe per pixel to read the "
                           "environment map, 1 … 4096 (default: the tier's: draft 2, standard "
                           "6, high 64, reference 1024; for the rotation source's "
-                          "Ashikhmin-Shirley lobes draft 3, standard 9). The spectral "
+                          "Ashikhmin-Shirley lobes draft 3, standard 9; for a grating, the "
+                          "reads along the curve its orders leave by, draft 2, standard 3, "
+                          "high 32, reference 512). The spectral "
                           "multi-peak lobe reads its envelope from the map's irradiance and "
                           "takes these only for its bands: at most one a pass per 4 "
                           "wavelengths, and none where `samples` (not this field) are too few "
                           "to resolve them (the presets' bands need 4 or more). Ignored where "
-                          "the environment becomes lights (environment_lights set, a grating, "
-                          "or the RGB multi-peak lobe, wavelengths=0).")
+                          "the environment becomes lights (environment_lights set, or "
+                          "wavelengths=0 with a grating or the multi-peak lobe).")
     environment_background: bool | None = Field(
         None, description="Show the environment behind the object instead of the preset's "
                           "background (default false).")

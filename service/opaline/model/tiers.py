@@ -48,6 +48,13 @@ class Tier:
     # brute-force reference (studio, A-S 100×1000, θ 0.5/1.0) 6 left FLIP 0.106, 9 0.088,
     # 12 0.079 (bench/environment_accuracy.py).
     environment_samples_rotation: int
+    # A grating's pieces of the curve its orders leave along, each read once
+    # (glsl/lib/environment_grating.glsl), over all the tier's samples together: against
+    # the same reads converged (bench/grating_environment.py, the grating presets, studio
+    # and sky, 128²) 2 measured FLIP 0.045-0.049 in the studio, 4 0.032-0.035; each piece
+    # costs about a tenth of the key light at 256², and standard's 3 keep the tier inside
+    # 1.5× it (bench/speed_env.py).
+    environment_samples_grating: int
     measured: Measured | None = None  # quality=auto only
 
     def render_settings(self) -> dict[str, int | str]:
@@ -59,7 +66,8 @@ class Tier:
         return {"name": self.name, **self.render_settings(),
                 "environment_lights": self.environment_lights,
                 "environment_samples": self.environment_samples,
-                "environment_samples_rotation": self.environment_samples_rotation}
+                "environment_samples_rotation": self.environment_samples_rotation,
+                "environment_samples_grating": self.environment_samples_grating}
 
 
 TIERS: dict[str, Tier] = {tier.name: tier for tier in (
@@ -68,17 +76,21 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # buy wavelengths before samples: one sample of 8 wavelengths, band-limited, costs
     # little more than one RGB sample and has a third to half of its error.
     Tier("draft", samples=1, wavelengths=8, aa="analytic",
-         environment_lights=8, environment_samples=2, environment_samples_rotation=3),
+         environment_lights=8, environment_samples=2, environment_samples_rotation=3,
+         environment_samples_grating=2),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
-         environment_lights=16, environment_samples=6, environment_samples_rotation=9),
+         environment_lights=16, environment_samples=6, environment_samples_rotation=9,
+         environment_samples_grating=3),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
     Tier("high", samples=8, wavelengths=16, aa="none",
-         environment_lights=32, environment_samples=64, environment_samples_rotation=64),
+         environment_lights=32, environment_samples=64, environment_samples_rotation=64,
+         environment_samples_grating=32),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
     Tier("reference", samples=64, wavelengths=32, aa="none",
-         environment_lights=64, environment_samples=1024, environment_samples_rotation=1024),
+         environment_lights=64, environment_samples=1024, environment_samples_rotation=1024,
+         environment_samples_grating=512),
 )}
 if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
     raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
@@ -99,4 +111,5 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
                 max(like.environment_lights, high.environment_lights),
                 max(like.environment_samples, high.environment_samples),
                 max(like.environment_samples_rotation, high.environment_samples_rotation),
+                max(like.environment_samples_grating, high.environment_samples_grating),
                 measured)

@@ -58,6 +58,41 @@ def density_table() -> tuple[np.ndarray, np.ndarray]:
     return grid, table
 
 
+@lru_cache(maxsize=1)
+def cumulative_table() -> np.ndarray:
+    """∫ ŵ(λ) dλ from 380 nm to each point of ``density_table``'s grid, (TABLE_SIZE, 3):
+    exact for its piecewise-linear density, 0 at 380 nm and 1 at 780 nm."""
+    grid, table = density_table()
+    steps = 0.5 * (table[1:] + table[:-1]) * np.diff(grid)[:, None]
+    cumulative = np.concatenate([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
+    cumulative.setflags(write=False)
+    return cumulative
+
+
+def cumulative_at(lam_nm: npt.ArrayLike) -> np.ndarray:
+    """The cumulative table, linear between its points and held beyond its ends.
+
+    Mirrors ``visible_cumulative`` in glsl/lib/environment_grating.glsl."""
+    grid, _ = density_table()
+    lam = np.asarray(lam_nm, dtype=np.float64)
+    table = cumulative_table()
+    return np.stack([np.interp(lam, grid, table[:, c]) for c in range(3)], axis=-1)
+
+
+def filtered_density(lam_nm: npt.ArrayLike, half_nm: npt.ArrayLike) -> np.ndarray:
+    """ŵ(λ) averaged over λ ± half (a lobe's extent in wavelength), from the cumulative
+    table; the plain density where half is under half a table step.
+
+    Mirrors ``visible_filtered`` in glsl/lib/grating.glsl."""
+    lam = np.asarray(lam_nm, dtype=np.float64)
+    half = np.broadcast_to(np.asarray(half_nm, dtype=np.float64), lam.shape)
+    wide = half >= 0.5 * TABLE_STEP_NM
+    safe = np.where(wide, half, 1.0)[..., None]
+    average = (cumulative_at(lam + np.where(wide, half, 1.0))
+               - cumulative_at(lam - np.where(wide, half, 1.0))) / (2.0 * safe)
+    return np.where(wide[..., None], average, density_at(lam))
+
+
 def density_at(lam_nm: npt.ArrayLike) -> np.ndarray:
     """ŵ(λ) per nm by linear interpolation in the table; 0 outside the visible range.
 

@@ -62,3 +62,5 @@ class TierInfo(BaseModel):
     environment_samples_rotation: int = Field(
         description="The same for the rotation source's Ashikhmin-Shirley lobes (three of "
                     "them, one a channel).")
+    environment_samples_grating: int = Field(
+        description="The same for a grating: reads along the curve its orders leave by.")
