@@ -11,6 +11,7 @@ from typing import Any
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
 from opaline.scene.environments import MESH_ENVIRONMENT
+from opaline.scene.gltf_film import has_thickness_texture
 
 MESH_KIND = "file"
 # The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
@@ -28,9 +29,10 @@ def file_digest(path: Path) -> str:
 
 def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max_triangles: int) -> Preset:
     """``base`` drawing the mesh at ``path``: its background, defaults and maps, lit by
-    ``MESH_ENVIRONMENT`` unless the preset names an environment, the camera framed on the mesh by the renderer (the maps projected
-    in object space where the mesh has no UVs, or where the preset asks:
-    ``opaline.model.projection``)."""
+    ``MESH_ENVIRONMENT`` unless the preset names an environment, the camera framed on the
+    mesh by the renderer (the maps projected in object space where the mesh has no UVs, or
+    where the preset asks: ``opaline.model.projection``). A .glb carrying a KHR thickness
+    texture draws its film with it instead of the preset's field."""
     # The generator's arguments (scene.meshfile.mesh_file's), of their several types.
     args: dict[str, Any] = {"kind": MESH_KIND, "path": str(path), "digest": digest,
                             "tangent_field": request.tangent_field or _default_field(base),
@@ -38,9 +40,13 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
                             "max_triangles": max_triangles}
     defaults = base.defaults.model_copy(
         update={"environment": base.defaults.environment or MESH_ENVIRONMENT})
-    return base.model_copy(update={"name": f"mesh-{digest[:12]}",
-                                   "geometry": Generator(**args), "defaults": defaults,
-                                   "tangents": "uv", "rotation_deg": (0.0, 0.0, 0.0)})
+    update: dict[str, Any] = {"name": f"mesh-{digest[:12]}", "geometry": Generator(**args),
+                              "defaults": defaults, "tangents": "uv",
+                              "rotation_deg": (0.0, 0.0, 0.0)}
+    if has_thickness_texture(path):  # a .glb's own film, in its own UVs
+        film: dict[str, Any] = {"kind": "glb", "path": str(path), "digest": digest}
+        update.update(thickness_map=Generator(**film), mesh_projection="auto")
+    return base.model_copy(update=update)
 
 
 def _default_field(base: Preset) -> str:

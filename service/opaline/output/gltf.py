@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,6 @@ from opaline.model.params import MATERIAL_FIELDS, Material
 from opaline.model.presets import Preset, build_assets, build_thickness
 from opaline.output.gltf_iridescence import (
     IOR,
-    IRIDESCENCE,
     add_thickness_texture,
     base_colour_and_metallic,
     is_thin_film,
@@ -33,6 +33,12 @@ from opaline.output.gltf_iridescence import (
     thickness_png,
     thin_film_extensions,
     thin_film_fields,
+)
+from opaline.scene.gltf_film import (
+    IRIDESCENCE,
+    FilmTextures,
+    has_thickness_texture,
+    read_film_textures,
 )
 from opaline.scene.mesh import Mesh
 
@@ -49,11 +55,12 @@ def _roughness(material: Material) -> float:
 
 def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str = "opaline",
                tangents: dict[str, Any] | None = None,
-               thickness: np.ndarray | None = None) -> bytes:
+               textures: FilmTextures | None = None) -> bytes:
     """``tangents``: the request fields (``tangent_field``, ``tangent_axis``) that give the
     mesh's tangents back when it is imported (the CD's are concentric, not its UVs').
-    ``thickness``: the preset's [0, 1] film-thickness field, written as KHR's thickness
-    texture when the material is a thin film."""
+    ``textures``: the [0, 1] film-thickness field (the preset's, or a user's .glb's) and
+    a .glb's own factor texture, written as KHR's textures when the material is a thin
+    film."""
     arrays = [
         (mesh.positions, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
         (mesh.normals, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
@@ -76,10 +83,10 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         accessors.append(accessor)
         blob += raw + b"\0" * (-len(raw) % 4)
     film = is_thin_film(material)
-    image_view = None
-    if film and thickness is not None:
-        raw = thickness_png(thickness)
-        image_view = len(views)
+    image_views: dict[str, int] = {}
+    for key, field in _film_fields(textures if film else None).items():
+        raw = thickness_png(field)
+        image_views[key] = len(views)
         views.append(gl.BufferView(buffer=0, byteOffset=len(blob), byteLength=len(raw)))
         blob += raw + b"\0" * (-len(raw) % 4)
     params = material.model_dump(mode="json")
@@ -103,8 +110,8 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         meshes=[gl.Mesh(name=name, primitives=[primitive])], materials=[gltf_material],
         accessors=accessors, bufferViews=views, buffers=[gl.Buffer(byteLength=len(blob))])
     if film:
-        texture = None if image_view is None else add_thickness_texture(document, image_view)
-        gltf_material.extensions = thin_film_extensions(material, texture)
+        indices = {key: add_thickness_texture(document, view) for key, view in image_views.items()}
+        gltf_material.extensions = thin_film_extensions(material, indices)
         document.extensionsUsed = [IRIDESCENCE, IOR]
     document.set_binary_blob(blob)
     return b"".join(document.save_to_bytes())
@@ -121,11 +128,26 @@ def tangent_fields(preset: Preset) -> dict[str, Any]:
     return {}
 
 
+def _film_fields(textures: FilmTextures | None) -> dict[str, np.ndarray]:
+    """The KHR texture each present field is written as."""
+    if textures is None:
+        return {}
+    fields = {"iridescenceThicknessTexture": textures.thickness,
+              "iridescenceTexture": textures.factor}
+    return {key: field for key, field in fields.items() if field is not None}
+
+
 def export_preset_glb(preset: Preset, material: Material, wavelengths: int = 0) -> bytes:
-    """The preset's mesh, tangent fields and (for a thin film) thickness field as .glb."""
+    """The preset's mesh, tangent fields and (for a thin film) thickness field as .glb; a
+    user's .glb gives back the factor texture it came with too."""
     mesh, _ = build_assets(preset)
-    thickness = build_thickness(preset) if is_thin_film(material) else None
-    return export_glb(mesh, material, wavelengths, preset.name, tangent_fields(preset), thickness)
+    textures = None
+    if is_thin_film(material):
+        factor = None
+        if is_mesh(preset) and has_thickness_texture(Path(preset.geometry.args["path"])):
+            factor = read_film_textures(Path(preset.geometry.args["path"]).read_bytes()).factor
+        textures = FilmTextures(build_thickness(preset), factor)
+    return export_glb(mesh, material, wavelengths, preset.name, tangent_fields(preset), textures)
 
 
 class GltfImportError(ValueError):

@@ -11,17 +11,16 @@ KHR_materials_ior) whose colour is the metal's bare F0, which KHR viewers use as
 the metal's reflectance under the film; a metallic file imports back as the
 ``artist`` metal of that F0 (edge tint white). A preset's thickness field is written as
 iridescenceThicknessTexture: 8-bit grey RGB (KHR reads G), 1/255 of the range
-per step.
+per step; a user's .glb's own textures go back as they came (scene.gltf_film).
 
 Import reads the same names back, iridescenceFactor into film_weight (a factor of 0,
 no film, is refused: that is a plain material), with the extension's defaults (ior
 1.3, thickness 100-400 nm) where a key is absent and the glTF base ior 1.5 without
-KHR_materials_ior. Neither texture in the file is imported: a request has no
-thickness field of its own (a thickness field belongs to the preset, and a user's mesh
-takes its preset's), so the film is film_thickness_max everywhere, as KHR's is without
-a thickness texture; and the weight is one number per material, so an
-iridescenceTexture (KHR's per-texel factor, R) is not read: iridescenceFactor alone
-gives film_weight.
+KHR_materials_ior. The imported material file draws the .glb itself as its mesh, and a
+.glb with a thickness texture draws its film with it, in its own UVs
+(scene.gltf_film). The weight is one number per material in the shader: an
+iridescenceTexture (KHR's per-texel factor, R) is carried through to the export but
+not drawn; iridescenceFactor alone gives film_weight.
 """
 
 from __future__ import annotations
@@ -37,8 +36,8 @@ from pydantic import ValidationError
 from opaline.model import metals
 from opaline.model.params import Material, MaterialFields
 from opaline.model.spectrum import rgb_weights
+from opaline.scene.gltf_film import IRIDESCENCE
 
-IRIDESCENCE = "KHR_materials_iridescence"
 IOR = "KHR_materials_ior"
 # KHR_materials_iridescence's defaults (iridescenceFactor's is 0: no film).
 KHR_IOR, KHR_THICKNESS_MIN, KHR_THICKNESS_MAX = 1.3, 100.0, 400.0
@@ -50,16 +49,17 @@ def is_thin_film(material: Material) -> bool:
     return material.iridescence == "thin-film"
 
 
-def thin_film_extensions(material: Material, thickness_texture: int | None) -> dict[str, Any]:
-    """The material's ``extensions`` entries; ``thickness_texture``: a texture index or None."""
+def thin_film_extensions(material: Material, textures: dict[str, int]) -> dict[str, Any]:
+    """The material's ``extensions`` entries; ``textures``: the texture index of each KHR
+    texture written (iridescenceThicknessTexture, iridescenceTexture)."""
     film: dict[str, Any] = {
         "iridescenceFactor": float(material.film_weight),
         "iridescenceIor": float(material.film_ior),
         "iridescenceThicknessMinimum": float(material.film_thickness_min),
         "iridescenceThicknessMaximum": float(material.film_thickness_max),
     }
-    if thickness_texture is not None:
-        film["iridescenceThicknessTexture"] = {"index": thickness_texture, "texCoord": 0}
+    for key, index in textures.items():
+        film[key] = {"index": index, "texCoord": 0}
     if material.substrate == "conductor":  # a metallic base: no index under the film
         return {IRIDESCENCE: film}
     return {IRIDESCENCE: film, IOR: {"ior": float(material.substrate_ior)}}

@@ -9,6 +9,7 @@ top, v = 1), like the normal maps; the upload flips rows.
   at the top (v = 1), thickening downward, with horizontal swirls.
 - ``platelets``: Voronoi cells, each its own thickness (nacre's aragonite tablets).
 - ``file``: a greyscale image next to the preset.
+- ``glb``: a user's .glb's own KHR thickness texture (``scene.gltf_film``).
 """
 
 from __future__ import annotations
@@ -122,11 +123,27 @@ def _file(path: str | os.PathLike[str]) -> np.ndarray:
     return field
 
 
+def _glb(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
+    """The thickness texture of a user's .glb (``digest``: the file's, for the scene key)."""
+    from opaline.scene.gltf_film import IRIDESCENCE, read_film_textures
+
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read()
+    except OSError as error:
+        raise ValueError(f"argument 'path': cannot read {str(path)!r}: {error}") from None
+    field = read_film_textures(data).thickness
+    if field is None:
+        raise ValueError(f"argument 'path': {str(path)!r} has no {IRIDESCENCE} thickness texture")
+    return field
+
+
 KINDS: dict[str, Callable[..., np.ndarray]] = {
     "swirl": swirl,
     "drain": drain,
     "platelets": platelets,
     "file": _file,
+    "glb": _glb,
 }
 
 

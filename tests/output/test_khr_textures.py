@@ -1,0 +1,112 @@
+"""A .glb written by another tool with KHR_materials_iridescence at iridescenceFactor 0.5,
+a factor texture and a thickness texture: it imports with those values, draws its film
+with its own thickness texture (not the preset's field), and exports them back, texel for
+texel; a broken texture is refused with a message naming it."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pygltflib
+import pytest
+from PIL import Image
+
+from opaline.local.context import local_context
+from opaline.local.export import export_material, import_material
+from opaline.model.params import Material, RenderRequest
+from opaline.model.presets import build_assets, build_thickness, get_preset
+from opaline.output.gltf import export_glb
+from opaline.pipeline.prepare import prepare
+from opaline.scene.gltf_film import read_film_textures
+
+KHR = "KHR_materials_iridescence"
+RNG = np.random.default_rng(31)
+THICKNESS = RNG.integers(0, 256, (48, 64)).astype(np.uint8)  # not square: rows stay rows
+FACTOR = RNG.integers(0, 256, (32, 32)).astype(np.uint8)
+
+
+def png(channel: np.ndarray, index: int) -> bytes:
+    """A texture whose KHR channel holds ``channel`` and whose others hold noise (KHR reads
+    G of the thickness texture and R of the factor texture, nothing else)."""
+    rgb = RNG.integers(0, 256, (*channel.shape, 3)).astype(np.uint8)
+    rgb[..., index] = channel
+    out = io.BytesIO()
+    Image.fromarray(rgb, "RGB").save(out, "PNG")
+    return out.getvalue()
+
+
+def other_tools_glb(thickness_png: bytes | None = None) -> bytes:
+    """The sphere (it has UVs) as a .glb with a film of factor 0.5 and both textures."""
+    mesh, _ = build_assets(get_preset("sphere"))
+    document = pygltflib.GLTF2.load_from_bytes(export_glb(mesh, Material()))
+    blob = document.binary_blob()
+    images = {"iridescenceThicknessTexture": thickness_png or png(THICKNESS, 1),
+              "iridescenceTexture": png(FACTOR, 0)}
+    film = {"iridescenceFactor": 0.5, "iridescenceIor": 1.4,
+            "iridescenceThicknessMinimum": 200.0, "iridescenceThicknessMaximum": 800.0}
+    for key, raw in images.items():
+        blob += b"\0" * (-len(blob) % 4)
+        document.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=len(blob),
+                                                         byteLength=len(raw)))
+        blob += raw
+        document.images.append(pygltflib.Image(bufferView=len(document.bufferViews) - 1,
+                                               mimeType="image/png"))
+        document.textures.append(pygltflib.Texture(source=len(document.images) - 1))
+        film[key] = {"index": len(document.textures) - 1}
+    material = document.materials[0]
+    material.extras = {}  # another tool: no Opaline parameters, the extension alone
+    material.extensions = {KHR: film}
+    document.extensionsUsed = [KHR]
+    document.buffers[0].byteLength = len(blob)
+    document.set_binary_blob(blob)
+    return b"".join(document.save_to_bytes())
+
+
+def test_imports_draws_and_exports_the_factor_and_both_textures(tmp_path):
+    path = tmp_path / "film.glb"
+    path.write_bytes(other_tools_glb())
+    fields = import_material(path, preset="nacre-film")
+    assert fields["film_weight"] == 0.5 and fields["mesh"] == str(path)
+    assert (fields["film_thickness_min"], fields["film_thickness_max"]) == (200.0, 800.0)
+
+    # The film is drawn with the file's thickness texture, in the mesh's UVs, not with
+    # nacre-film's tablets projected over it.
+    request = RenderRequest.model_validate(fields)
+    preset = prepare(request, local_context(cost_budget=None)).preset
+    assert preset.thickness_map is not None and preset.thickness_map.kind == "glb"
+    assert preset.mesh_projection == "auto"
+    np.testing.assert_array_equal(build_thickness(preset), THICKNESS / np.float32(255.0))
+
+    exported = read_film_textures(export_material(fields, "glb"))
+    document = pygltflib.GLTF2.load_from_bytes(export_material(fields, "glb"))
+    film = document.materials[0].extensions[KHR]
+    assert film["iridescenceFactor"] == 0.5
+    assert (film["iridescenceThicknessMinimum"], film["iridescenceThicknessMaximum"]) == (
+        200.0, 800.0)
+    assert exported.thickness is not None and exported.factor is not None
+    np.testing.assert_array_equal(np.round(exported.thickness * 255.0), THICKNESS)
+    np.testing.assert_array_equal(np.round(exported.factor * 255.0), FACTOR)
+
+
+def test_a_glb_without_film_textures_keeps_its_presets_field(tmp_path):
+    path = tmp_path / "plain.glb"
+    path.write_bytes(export_material({"preset": "sphere"}, "glb"))
+    preset = prepare(RenderRequest(preset="nacre-film", mesh=str(path)),
+                     local_context(cost_budget=None)).preset
+    assert preset.thickness_map == get_preset("nacre-film").thickness_map
+
+
+@pytest.mark.parametrize("raw,message", [
+    (b"not an image", "not a readable image"),
+    (b"GIF89a" + bytes(64), "not a readable image"),
+], ids=["garbage", "truncated-gif"])
+def test_a_broken_texture_is_refused_naming_it(tmp_path, raw, message):
+    with pytest.raises(ValueError, match=f"iridescenceThicknessTexture: {message}"):
+        read_film_textures(other_tools_glb(thickness_png=raw))
+
+
+def test_a_huge_texture_is_refused_before_it_is_decoded(monkeypatch):
+    monkeypatch.setattr("opaline.scene.gltf_film.MAX_TEXELS", 100)
+    with pytest.raises(ValueError, match="64×48 texels, more than 100"):
+        read_film_textures(other_tools_glb())
