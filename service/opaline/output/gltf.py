@@ -13,7 +13,6 @@ and a .glb with that extension and no extras imports as a thin-film material.
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +37,7 @@ from opaline.scene.gltf_film import (
     IRIDESCENCE,
     FilmTextures,
     has_thickness_texture,
+    load_document,
     read_film_textures,
 )
 from opaline.scene.mesh import Mesh
@@ -157,13 +157,9 @@ class GltfImportError(ValueError):
 def import_glb(data: bytes) -> dict[str, Any]:
     """Request fields (material and wavelengths) from a .glb's first material."""
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # pygltflib warns, then may answer None
-            document = gl.GLTF2.load_from_bytes(data)
-    except Exception as exc:  # pygltflib fails in many ways on bad bytes
-        raise GltfImportError(f"not a readable .glb: {type(exc).__name__}: {exc}") from None
-    if document is None:
-        raise GltfImportError("not a readable .glb")
+        document = load_document(data)
+    except ValueError as exc:
+        raise GltfImportError(str(exc)) from None
     if not document.materials:
         raise GltfImportError("the glTF file has no material")
     material = document.materials[0]

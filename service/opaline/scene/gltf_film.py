@@ -35,7 +35,8 @@ class FilmTextures:
     factor: np.ndarray | None  # [0, 1], times iridescenceFactor
 
 
-def _document(data: bytes) -> gl.GLTF2:
+def load_document(data: bytes) -> gl.GLTF2:
+    """A .glb's document; ValueError saying why where the bytes are not one."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # pygltflib warns, then may answer None
@@ -94,7 +95,7 @@ def _channel(raw: bytes, channel: int, key: str) -> np.ndarray:
 def read_film_textures(data: bytes) -> FilmTextures:
     """The thickness and factor textures of the first material's film, each None where
     the file has none; ValueError naming the texture where one cannot be read."""
-    document = _document(data)
+    document = load_document(data)
     film = _film(document)
     fields = {key: _channel(_image_bytes(document, film[key], key), channel, key)
               for key, channel in CHANNELS.items() if key in film}
