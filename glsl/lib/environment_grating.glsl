@@ -80,6 +80,16 @@ float grating_widen(Material mat, float kn) {
     return sqrt(3.0) * kn / sqrt(mat.ey + 1.0);
 }
 
+// Boundary i of the pieces, along the two stretches laid end to end: the cuts at
+// (k − offset)·step before the join, the join (the end of the first stretch), the rest.
+float grating_cut(int i, int join, float len_plus, float len_all, float step_b, float offset) {
+    if (i == join) {
+        return len_plus;
+    }
+    float k = float(i < join ? i : i - 1) - offset;
+    return clamp(k * step_b, 0.0, len_all);
+}
+
 vec3 environment_grating(Material mat, Environment env, realmat3 frame, vec3 v) {
     vec3 vl = vec3(transpose(frame) * real3(v));
     if (vl.z <= 0.0) {
@@ -90,32 +100,34 @@ vec3 environment_grating(Material mat, Environment env, realmat3 frame, vec3 v) 
     vec3 eta0 = vec3(grating_efficiency(0, mat.grating.channel_nm.r, 2.0 * vl.z, depth),
                      grating_efficiency(0, mat.grating.channel_nm.g, 2.0 * vl.z, depth),
                      grating_efficiency(0, mat.grating.channel_nm.b, 2.0 * vl.z, depth));
-    vec3 sum = eta0 / vl.z * grating_read(env, frame, vec3(-vl.xy, vl.z), vl.z, lobe_h, 0.0);
+    vec3 sum = eta0 / max(vl.z, EPS_DENOM) * grating_read(env, frame, vec3(-vl.xy, vl.z), vl.z, lobe_h, 0.0);
     // Where on the curve an order is seen, b + v_b ∈ ±[380/d, M·780/d] and a lobe's reach
-    // about it, within the horizon |b| < r: two stretches (q = ±(b + v_b) on each), cut
-    // into pieces of one length, the last of each shorter: the reads move with v, never
-    // jump from one stretch to the other.
+    // about it, within the horizon |b| < r: two stretches (q = ±(b + v_b) on each), laid
+    // end to end and cut every `step` from an offset, and once more where the first ends:
+    // ENV_GRATING_READS + 2 pieces cover both, none across the join, and the reads move
+    // with v, never jumping from one stretch to the other.
     float r = sqrt(max(1.0 - vl.x * vl.x, 0.0));
     float reach = grating_widen(mat, 1.0 + vl.z);
     vec2 q_range = vec2(380.0, float(GRATING_ORDERS) * 780.0) / mat.grating.pitch_nm
                    + vec2(-reach, reach);
     vec2 plus = clamp(q_range - vl.y, -r, r);
     vec2 minus = clamp(-q_range.yx - vl.y, -r, r);
-    float step_b = max(plus.y - plus.x + minus.y - minus.x, 1e-6) / float(ENV_GRATING_READS);
+    float len_plus = plus.y - plus.x;
+    float len_all = len_plus + minus.y - minus.x;
+    float step_b = max(len_all, 1e-6) / float(ENV_GRATING_READS);
     // Each pixel and pass cuts them at its own offset (a pass steps it by 1/φ): where
     // they met in one place for every pixel, the pieces' colours drew rings.
     float offset = fract(env_pixel_shift().x + float(env.pass) * 0.6180339887);
-    int pieces_plus = int(ceil((plus.y - plus.x) / step_b + offset));
+    int join = int(floor(len_plus / step_b + offset)) + 1;  // the cuts up to the join
     for (int j = 0; j < ENV_GRATING_READS + 2; ++j) {
-        bool on_plus = j < pieces_plus;
-        vec2 range = on_plus ? plus : minus;
-        float k = float(on_plus ? j : j - pieces_plus) - offset;
-        vec2 piece = clamp(range.x + vec2(k, k + 1.0) * step_b, range.x, range.y);
+        vec2 piece = vec2(grating_cut(j, join, len_plus, len_all, step_b, offset),
+                          grating_cut(j + 1, join, len_plus, len_all, step_b, offset));
         float half_b = 0.5 * (piece.y - piece.x);
         if (half_b <= 0.0) {
-            continue;  // a stretch's last piece, or the stretch, empty
+            continue;  // the first or last piece, or a stretch, empty
         }
-        float b = piece.x + half_b;
+        bool on_plus = piece.x < len_plus;
+        float b = on_plus ? plus.x + piece.x + half_b : minus.x + piece.x - len_plus + half_b;
         vec3 l = vec3(-vl.x, b, sqrt(max(r * r - b * b, 0.0)));
         float kn = l.z + vl.z;
         // The read lights the wavelengths whose lobes reach its piece, each by the share

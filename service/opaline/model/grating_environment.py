@@ -11,10 +11,11 @@ its albedo
     ∫ η_m·F·D(h_m)·(v·h_m)/(|k_m|²·max(n·l, n·v))·(n·l) dω_l ≈ η_m(λ)·F(n·v)·(n·v)/max(n·l, n·v),
 
 from dω_l = |k_m|²/(l·h_m)·dω_h and ∫ D dω_h ≈ 1 about h_m = n
-(``tests/model/test_grating_environment.py`` checks it by quadrature). The curve is cut
-where some order can be seen, b + v_b ∈ ±[380/d, M·780/d] (widened by a lobe's reach)
-within the horizon, into ``reads`` pieces of one length from an offset, the last of each
-stretch shorter; each piece is read once and lights each order falling on it by the
+(``tests/model/test_grating_environment.py`` checks it by quadrature). The two stretches
+of the curve where some order can be seen, b + v_b ∈ ±[380/d, M·780/d] (widened by a
+lobe's reach) within the horizon, are laid end to end and cut into ``reads`` pieces' length
+from an offset, and once more where the first ends (``reads`` + 2 pieces, the first and
+last shorter); each piece is read once and lights each order falling on it by the
 spectrum's weight over the piece's wavelengths (``visible.cumulative_at``) times η_m at
 two points of it; where the lobe is wider along b than the piece, by the lobe's box
 scaled to the piece's share. The mirror order is one read at the mirror direction, its η
@@ -103,9 +104,9 @@ def widen(material: Material, kn: FloatArray | float) -> FloatArray:
 def curve_points(material: Material, vl: FloatArray, reads: int, offset: float
                  ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The reads' b (..., reads + 2), their pieces' lengths and their q = ±(b + v_b): the
-    two stretches where an order is seen (and a lobe's reach about them) cut into pieces of
-    one length from ``offset`` pieces before each start, clipped to it, as the shader cuts
-    them (a piece of length 0 reads nothing)."""
+    two stretches where an order is seen (and a lobe's reach about them) laid end to end,
+    cut every step from ``offset`` steps before their start, and once more where the first
+    ends, as the shader cuts them (a piece of length 0 reads nothing)."""
     pitch_nm = 1000.0 * material.grating_pitch
     r = np.sqrt(np.maximum(1.0 - vl[..., 0] ** 2, 0.0))[..., None]
     reach = widen(material, 1.0 + vl[..., 2])[..., None]
@@ -114,17 +115,21 @@ def curve_points(material: Material, vl: FloatArray, reads: int, offset: float
     vb = vl[..., 1][..., None]
     plus = np.clip(np.concatenate([q_lo - vb, q_hi - vb], -1), -r, r)
     minus = np.clip(np.concatenate([-q_hi - vb, -q_lo - vb], -1), -r, r)
-    len_plus, len_minus = plus[..., 1] - plus[..., 0], minus[..., 1] - minus[..., 0]
-    step = np.maximum(len_plus + len_minus, 1e-6) / reads
-    pieces_plus = np.ceil(len_plus / step + offset)[..., None]
+    len_plus = (plus[..., 1] - plus[..., 0])[..., None]
+    len_all = len_plus + (minus[..., 1:] - minus[..., :1])
+    step = np.maximum(len_all, 1e-6) / reads
+    join = np.floor(len_plus / step + offset) + 1.0
+
+    def cut(i: FloatArray) -> FloatArray:
+        k = np.where(i < join, i, i - 1.0) - offset
+        result: FloatArray = np.where(i == join, len_plus, np.clip(k * step, 0.0, len_all))
+        return result
+
     j = np.arange(reads + 2, dtype=np.float64)
-    on_plus = j < pieces_plus
-    start = np.where(on_plus, plus[..., :1], minus[..., :1])
-    end = np.where(on_plus, plus[..., 1:], minus[..., 1:])
-    k = np.where(on_plus, j, j - pieces_plus) - offset
-    lo = np.clip(start + k * step[..., None], start, end)
-    hi = np.clip(start + (k + 1.0) * step[..., None], start, end)
-    b = 0.5 * (lo + hi)
+    lo, hi = cut(j), cut(j + 1.0)
+    on_plus = lo < len_plus
+    middle = 0.5 * (lo + hi)
+    b = np.where(on_plus, plus[..., :1] + middle, minus[..., :1] + middle - len_plus)
     q = np.where(on_plus, b + vb, -(b + vb))
     return b, hi - lo, q
 

@@ -51,9 +51,9 @@ class Tier:
     # A grating's pieces of the curve its orders leave along, each read once
     # (glsl/lib/environment_grating.glsl), over all the tier's samples together: against
     # the same reads converged (bench/grating_environment.py, the grating presets, studio
-    # and sky, 128²) 2 measured FLIP 0.045-0.049 in the studio, 4 0.032-0.035; each piece
-    # costs about a tenth of the key light at 256², and standard's 3 keep the tier inside
-    # 1.5× it (bench/speed_env.py).
+    # and sky, 128²) 1 measured FLIP 0.065-0.066 in the studio, 2 0.046-0.049, 3 0.039; a
+    # piece costs about a tenth of the key light at 256², and standard's 3 keep the tier
+    # inside 1.5× it, draft's 1 inside 3× the floor, where 2 were 2.8-2.9× (bench/speed_env.py).
     environment_samples_grating: int
     measured: Measured | None = None  # quality=auto only
 
@@ -77,7 +77,7 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # little more than one RGB sample and has a third to half of its error.
     Tier("draft", samples=1, wavelengths=8, aa="analytic",
          environment_lights=8, environment_samples=2, environment_samples_rotation=3,
-         environment_samples_grating=2),
+         environment_samples_grating=1),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
          environment_lights=16, environment_samples=6, environment_samples_rotation=9,
