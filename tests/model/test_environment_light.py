@@ -6,6 +6,8 @@ source's own sample count."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from opaline.model import environment_light as el
@@ -48,6 +50,9 @@ def test_admission_counts_the_split_lobe_as_at_most_one_light_and_the_bright_one
     assert el.light_equivalents(job(mu_f=1.0, alpha=1.0, beta=1.0)) == 1 + MAX_LIGHTS
     assert el.light_equivalents(job(environment_lights=16)) == 16
     assert el.light_equivalents(job(iridescence="grating")) == 1 + MAX_LIGHTS
+    # A request's own pieces are counted: 4096 of them cost about 410 lights.
+    many = job(iridescence="grating", environment_samples=4096)
+    assert el.light_equivalents(many) == math.ceil(4098 / 10) + MAX_LIGHTS
     standard = TIERS["standard"]
     assert el.light_equivalents(job(mdf="ashikhmin")) == (standard.environment_samples_rotation
                                                           + MAX_LIGHTS)

@@ -110,3 +110,67 @@ def test_a_huge_texture_is_refused_before_it_is_decoded(monkeypatch):
     monkeypatch.setattr("opaline.scene.gltf_film.MAX_TEXELS", 100)
     with pytest.raises(ValueError, match="64×48 texels, more than 100"):
         read_film_textures(other_tools_glb())
+
+
+def _edited(edit) -> bytes:
+    """other_tools_glb() with its JSON edited by ``edit`` (a dict), the binary chunk kept:
+    what a hostile writer can put there, which pygltflib itself would not write."""
+    import json
+    import struct
+
+    data = other_tools_glb()
+    length = struct.unpack("<I", data[12:16])[0]
+    header = json.loads(data[20:20 + length])
+    edit(header)
+    text = json.dumps(header).encode()
+    text += b" " * (-len(text) % 4)
+    rest = data[20 + length:]
+    body = struct.pack("<I", len(text)) + b"JSON" + text + rest
+    return b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body
+
+
+def _png_header(width: int, height: int) -> bytes:
+    """A PNG that declares a size and holds no pixels: what a decompression bomb starts as."""
+    import struct
+    import zlib
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    chunk = b"IHDR" + ihdr
+    return (b"\x89PNG\r\n\x1a\n" + struct.pack(">I", len(ihdr)) + chunk
+            + struct.pack(">I", zlib.crc32(chunk)))
+
+
+@pytest.mark.parametrize("edit,message", [
+    (lambda d: d["bufferViews"][-2].pop("byteLength"), "not inside the binary chunk"),
+    (lambda d: d["bufferViews"][-2].update(byteOffset=-64), "not inside the binary chunk"),
+    (lambda d: d.update(textures=None), "no texture 0"),
+    (lambda d: d["images"][0].pop("bufferView"), "only images in the .glb's binary"),
+], ids=["no-byte-length", "negative-offset", "no-textures", "image-by-uri"])
+def test_a_hostile_glb_is_refused_as_a_mesh_naming_its_texture(edit, message):
+    """The mesh loader checks the film's textures (uploads and files alike): a 422's
+    MeshError, never a crash, and a mesh without them is not read at all."""
+    from opaline.scene.meshfile import MeshError, parse_mesh
+
+    with pytest.raises(MeshError, match=message):
+        parse_mesh(_edited(edit), ".glb")
+
+
+def test_a_bomb_or_a_16_bit_texture(tmp_path):
+    """A texture declaring 20000 × 20000 texels is refused before a pixel is decoded; a
+    16-bit grey thickness texture keeps its precision instead of clipping to 8 bits."""
+    with pytest.raises(ValueError, match="not a readable image|more than"):
+        read_film_textures(other_tools_glb(thickness_png=_png_header(20000, 20000)))
+    grey = (np.arange(64 * 48, dtype=np.uint32).reshape(48, 64) * 21).astype(np.uint16)
+    out = io.BytesIO()
+    Image.fromarray(grey).save(out, "PNG")
+    field = read_film_textures(other_tools_glb(thickness_png=out.getvalue())).thickness
+    np.testing.assert_allclose(field, grey / 65535.0, atol=1e-6)
+
+
+def test_the_json_chunk_alone_says_whether_a_file_has_a_film(tmp_path):
+    from opaline.scene.gltf_film import has_thickness_texture, texture_names
+
+    path = tmp_path / "film.glb"
+    path.write_bytes(other_tools_glb())
+    assert has_thickness_texture(path)
+    assert texture_names(b"glTF" + bytes(8) + b"\xff\xff\xff\x7fJSON" + b"[" * 100000) == set()

@@ -23,6 +23,7 @@ from opaline.scene.bright import MAX_LIGHTS
 # matching weights (which go negative): at 6 samples of 16 wavelengths, colour noise
 # took the sphere's FLIP from 0.127 (4 samples) to 0.19.
 WAVELENGTHS_PER_SAMPLE = 4
+GRATING_PIECES_PER_LIGHT = 10
 
 
 def reads_map(job: Job) -> bool:
@@ -70,9 +71,11 @@ def light_equivalents(job: Job) -> int:
     bands' samples of a pass, one spectral evaluation together)."""
     if not reads_map(job):
         return job.environment_count
-    if reads_orders(job):
-        return 1 + MAX_LIGHTS  # every order's read, as one light evaluates every order
     per_pass = math.ceil(job.environment_sample_count / job.samples)
+    if reads_orders(job):
+        # A piece of the orders' curve (two more than asked, at most) costs about a tenth
+        # of a light that evaluates every order (bench/speed_env.py).
+        return math.ceil((per_pass + 2) / GRATING_PIECES_PER_LIGHT) + MAX_LIGHTS
     if splits_lobe(job):
         return min(1, band_samples(job, per_pass)) + MAX_LIGHTS
     return per_pass + MAX_LIGHTS

@@ -36,9 +36,9 @@ from opaline.output.gltf_iridescence import (
 from opaline.scene.gltf_film import (
     IRIDESCENCE,
     FilmTextures,
-    has_thickness_texture,
     load_document,
     read_film_textures,
+    texture_names,
 )
 from opaline.scene.mesh import Mesh
 
@@ -144,8 +144,10 @@ def export_preset_glb(preset: Preset, material: Material, wavelengths: int = 0) 
     textures = None
     if is_thin_film(material):
         factor = None
-        if is_mesh(preset) and has_thickness_texture(Path(preset.geometry.args["path"])):
-            factor = read_film_textures(Path(preset.geometry.args["path"]).read_bytes()).factor
+        if is_mesh(preset):
+            data = Path(preset.geometry.args["path"]).read_bytes()
+            if "iridescenceTexture" in texture_names(data):
+                factor = read_film_textures(data, ("iridescenceTexture",)).factor
         textures = FilmTextures(build_thickness(preset), factor)
     return export_glb(mesh, material, wavelengths, preset.name, tangent_fields(preset), textures)
 

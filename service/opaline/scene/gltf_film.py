@@ -51,26 +51,32 @@ def load_document(data: bytes) -> gl.GLTF2:
 def _film(document: gl.GLTF2) -> dict[str, Any]:
     if not document.materials:
         return {}
-    film = (document.materials[0].extensions or {}).get(IRIDESCENCE)
+    extensions = document.materials[0].extensions
+    film = extensions.get(IRIDESCENCE) if isinstance(extensions, dict) else None
     return film if isinstance(film, dict) else {}
 
 
+def _index(value: Any, items: Any, what: str, key: str) -> int:
+    count = len(items) if isinstance(items, list) else 0
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < count:
+        raise ValueError(f"{IRIDESCENCE}.{key}: no {what} {value!r} in the file")
+    return value
+
+
 def _image_bytes(document: gl.GLTF2, info: Any, key: str) -> bytes:
-    index = info.get("index") if isinstance(info, dict) else None
-    if not isinstance(index, int) or not 0 <= index < len(document.textures):
-        raise ValueError(f"{IRIDESCENCE}.{key}: no texture {index!r} in the file")
-    source = document.textures[index].source
-    if not isinstance(source, int) or not 0 <= source < len(document.images):
-        raise ValueError(f"{IRIDESCENCE}.{key}: its texture has no image")
+    index = _index(info.get("index") if isinstance(info, dict) else None,
+                   document.textures, "texture", key)
+    source = _index(document.textures[index].source, document.images, "image", key)
     view_index = document.images[source].bufferView
-    if not isinstance(view_index, int) or not 0 <= view_index < len(document.bufferViews):
+    if view_index is None:
         raise ValueError(f"{IRIDESCENCE}.{key}: only images in the .glb's binary chunk are read")
-    view = document.bufferViews[view_index]
+    view = document.bufferViews[_index(view_index, document.bufferViews, "bufferView", key)]
     blob = document.binary_blob() or b""
-    start = view.byteOffset or 0
-    if start + view.byteLength > len(blob):
-        raise ValueError(f"{IRIDESCENCE}.{key}: its image runs past the binary chunk")
-    return bytes(blob[start:start + view.byteLength])
+    start, length = view.byteOffset or 0, view.byteLength
+    if not (isinstance(start, int) and isinstance(length, int) and start >= 0 and length >= 0
+            and start + length <= len(blob)):
+        raise ValueError(f"{IRIDESCENCE}.{key}: its image is not inside the binary chunk")
+    return bytes(blob[start:start + length])
 
 
 def _channel(raw: bytes, channel: int, key: str) -> np.ndarray:
@@ -84,38 +90,53 @@ def _channel(raw: bytes, channel: int, key: str) -> np.ndarray:
                                  f"{MAX_TEXELS}")
             if image.format not in ("PNG", "JPEG"):
                 raise ValueError(f"{IRIDESCENCE}.{key}: a {image.format} image, not PNG or JPEG")
-            bands = image.convert("RGB").split()
-            values = np.asarray(bands[channel], dtype=np.float32)
-    except OSError as error:
+            if image.mode.startswith("I"):  # 16-bit grey: every channel is the grey
+                field: np.ndarray = np.asarray(image, dtype=np.float32) / 65535.0
+                return field
+            values = np.asarray(image.convert("RGB").split()[channel], dtype=np.float32)
+    except (OSError, Image.DecompressionBombError) as error:
         raise ValueError(f"{IRIDESCENCE}.{key}: not a readable image: {error}") from None
-    field: np.ndarray = values / 255.0
-    return field
+    return values / 255.0
 
 
-def read_film_textures(data: bytes) -> FilmTextures:
-    """The thickness and factor textures of the first material's film, each None where
-    the file has none; ValueError naming the texture where one cannot be read."""
+def read_film_textures(data: bytes, keys: tuple[str, ...] = tuple(CHANNELS)) -> FilmTextures:
+    """The thickness and factor textures of the first material's film (of ``keys``, the
+    KHR names), each None where the file has none; ValueError naming the texture where
+    one cannot be read."""
     document = load_document(data)
     film = _film(document)
-    fields = {key: _channel(_image_bytes(document, film[key], key), channel, key)
-              for key, channel in CHANNELS.items() if key in film}
+    fields = {key: _channel(_image_bytes(document, film[key], key), CHANNELS[key], key)
+              for key in keys if key in film}
     return FilmTextures(fields.get("iridescenceThicknessTexture"),
                         fields.get("iridescenceTexture"))
 
 
-def has_thickness_texture(path: Path) -> bool:
-    """Whether a mesh file is a .glb whose first material's film names a thickness texture:
-    its JSON chunk alone is read (a request's scene is prepared from it; the image is
-    decoded when the scene is built, where a bad one is reported)."""
-    with open(path, "rb") as stream:
-        header = stream.read(20)
-        if len(header) < 20 or header[:4] != b"glTF" or header[16:20] != b"JSON":
-            return False
-        length = struct.unpack("<I", header[12:16])[0]
-        text = stream.read(length)
+def texture_names(head: bytes) -> set[str]:
+    """The KHR textures a .glb's first material's film names, from the start of the file
+    (its JSON chunk; the rest is not needed): none where it is not a .glb or has no film."""
+    if len(head) < 20 or head[:4] != b"glTF" or head[16:20] != b"JSON":
+        return set()
+    length = struct.unpack("<I", head[12:16])[0]
     try:
-        document = json.loads(text)
+        document = json.loads(head[20:20 + length])
         film = document["materials"][0]["extensions"][IRIDESCENCE]
-    except (ValueError, LookupError, TypeError):
-        return False  # the mesh loader says what is wrong with the file
-    return isinstance(film, dict) and "iridescenceThicknessTexture" in film
+    except (ValueError, LookupError, TypeError, RecursionError):
+        return set()  # the mesh loader says what is wrong with the file
+    return set(CHANNELS) & set(film) if isinstance(film, dict) else set()
+
+
+def has_thickness_texture(path: Path) -> bool:
+    """Whether a mesh file is a .glb whose film names a thickness texture: its JSON chunk
+    alone is read (a request's scene is prepared from it; the mesh loader decodes and
+    checks the image, ``check_film_textures``)."""
+    with open(path, "rb") as stream:
+        head = stream.read(20)
+        if len(head) == 20 and head[:4] == b"glTF":
+            head += stream.read(struct.unpack("<I", head[12:16])[0])
+    return "iridescenceThicknessTexture" in texture_names(head)
+
+
+def check_film_textures(data: bytes) -> None:
+    """ValueError naming the film texture of a .glb that cannot be drawn or exported."""
+    if texture_names(data):
+        read_film_textures(data)

@@ -25,6 +25,7 @@ import numpy as np
 
 from opaline.scene import meshlimits
 from opaline.scene import tangents as tangent_fields
+from opaline.scene.gltf_film import check_film_textures
 from opaline.scene.mesh import Mesh, make_mesh
 from opaline.scene.parse_memory import parse_ceiling, parse_headroom
 
@@ -109,8 +110,13 @@ def parse_mesh(data: bytes, suffix: str = "", field: str = "auto",
     if not data:
         raise MeshError("empty file: expected a glTF/GLB, OBJ, PLY or STL mesh")
     fmt = sniff(data, suffix)
+    if fmt == "glb":  # a film's textures are drawn and exported with the mesh
+        try:
+            check_film_textures(data)
+        except ValueError as exc:
+            raise MeshError(str(exc)) from None
     try:
-        data = meshlimits.check(data, fmt, max_triangles)
+        data = meshlimits.check(data, fmt, max_triangles)  # (a .glb's images left out)
     except meshlimits.LimitError as exc:
         raise MeshError(str(exc)) from None
     loaded = _parse(data, fmt)

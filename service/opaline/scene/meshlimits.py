@@ -119,7 +119,7 @@ def _gltf(data: bytes, fmt: str, max_triangles: int) -> bytes:
     check_gltf_header(header, bin_length, vertex_limit(max_triangles), max_triangles)
     if "images" not in header:
         return data
-    del header["images"]  # never decoded: the renderer does not sample textures
+    del header["images"]  # not by trimesh: a film's textures are read by scene.gltf_film
     text = json.dumps(header, separators=(",", ":")).encode()
     if fmt == "gltf":
         return text

@@ -132,7 +132,7 @@ def _glb(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
             data = stream.read()
     except OSError as error:
         raise ValueError(f"argument 'path': cannot read {str(path)!r}: {error}") from None
-    field = read_film_textures(data).thickness
+    field = read_film_textures(data, ("iridescenceThicknessTexture",)).thickness
     if field is None:
         raise ValueError(f"argument 'path': {str(path)!r} has no {IRIDESCENCE} thickness texture")
     return field
