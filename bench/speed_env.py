@@ -38,7 +38,7 @@ from report import save  # bench/report.py: run from bench/, it is on the path
 from speed import FLOOR, SIZE, Child
 
 PRESETS = ("sphere", "nacre-film", "oil-film", "soap-bubble", "cd-rom", "cd-rom-grating",
-           "dvd-grating")
+           "dvd-grating", "cd-rom-ashikhmin")
 ENVIRONMENT = "studio"
 TARGETS = {"standard_over_key": 1.5, "draft_over_floor": 3.0}
 AIM = 0.2  # the margin aimed for: 20 % inside each target
