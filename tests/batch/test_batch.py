@@ -411,10 +411,14 @@ HEAVY = 'preset = "cd-rom"\nmu_f = {mu}\nwidth = 384\nheight = 384\nsamples = 16
 
 def start_batch(folder: Path, out: Path, jobs: int, backend: str) -> subprocess.Popen:
     env = {**os.environ, "CI": "true"}
+    # As from a terminal: Ctrl-C's default disposition. A child inherits an ignored SIGINT
+    # (a background job's, or one a test in this process left ignored), and Python then
+    # installs no KeyboardInterrupt for it: the run would ignore the signal and finish.
     return subprocess.Popen(
         [sys.executable, "-m", "opaline.cli.main", "batch", str(folder), "--out", str(out),
          "--jobs", str(jobs), "--backend", backend],
-        cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def interrupt_after_first_image(process: subprocess.Popen, out: Path, sig: int) -> str:
