@@ -35,8 +35,8 @@ def reads_map(job: Job) -> bool:
 
 
 def reads_orders(job: Job) -> bool:
-    """Whether the map is read where a grating's orders leave, one read an order and
-    wavelength, instead of through lobe samples."""
+    """Whether the map is read along the curve a grating's orders leave by, in pieces
+    (glsl/lib/environment_grating.glsl), instead of through lobe samples."""
     return reads_map(job) and job.material.iridescence == "grating"
 
 

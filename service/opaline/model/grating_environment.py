@@ -79,7 +79,8 @@ def stretch_weight(material: Material, m: int, q: FloatArray, half: FloatArray,
                    kn: FloatArray) -> FloatArray:
     """Order m at the stretch |b + v_b| ∈ q ± half, (..., 3): over each half of its
     wavelengths, the spectrum's weight times η_m at that half's middle (η changes across
-    a stretch: at one point, 8 reads were 11 % off under a constant map, at two 3 %)."""
+    a stretch: at one point a stretch the error under a constant map was about three
+    times as large)."""
     per_nm = 1000.0 * material.grating_pitch / m
     lo, mid, hi = per_nm * (q - half), per_nm * q, per_nm * (q + half)
     visible_part = (hi > RANGE_NM[0]) & (lo < RANGE_NM[1])

@@ -25,11 +25,11 @@ from opaline.model.params import MATERIAL_FIELDS, Material
 from opaline.model.presets import Preset, build_assets, build_thickness
 from opaline.output.gltf_iridescence import (
     IOR,
-    add_thickness_texture,
+    add_film_texture,
     base_colour_and_metallic,
+    field_png,
     is_thin_film,
     roughness_from_exponent,
-    thickness_png,
     thin_film_extensions,
     thin_film_fields,
 )
@@ -84,8 +84,8 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         blob += raw + b"\0" * (-len(raw) % 4)
     film = is_thin_film(material)
     image_views: dict[str, int] = {}
-    for key, field in _film_fields(textures if film else None).items():
-        raw = thickness_png(field)
+    for key, field in (textures.by_key() if film and textures else {}).items():
+        raw = field_png(field)
         image_views[key] = len(views)
         views.append(gl.BufferView(buffer=0, byteOffset=len(blob), byteLength=len(raw)))
         blob += raw + b"\0" * (-len(raw) % 4)
@@ -110,7 +110,7 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         meshes=[gl.Mesh(name=name, primitives=[primitive])], materials=[gltf_material],
         accessors=accessors, bufferViews=views, buffers=[gl.Buffer(byteLength=len(blob))])
     if film:
-        indices = {key: add_thickness_texture(document, view) for key, view in image_views.items()}
+        indices = {key: add_film_texture(document, view) for key, view in image_views.items()}
         gltf_material.extensions = thin_film_extensions(material, indices)
         document.extensionsUsed = [IRIDESCENCE, IOR]
     document.set_binary_blob(blob)
@@ -126,15 +126,6 @@ def tangent_fields(preset: Preset) -> dict[str, Any]:
     if preset.tangents == "concentric":  # about the object's y axis, as the shader's field
         return {"tangent_field": "concentric", "tangent_axis": [0.0, 1.0, 0.0]}
     return {}
-
-
-def _film_fields(textures: FilmTextures | None) -> dict[str, np.ndarray]:
-    """The KHR texture each present field is written as."""
-    if textures is None:
-        return {}
-    fields = {"iridescenceThicknessTexture": textures.thickness,
-              "iridescenceTexture": textures.factor}
-    return {key: field for key, field in fields.items() if field is not None}
 
 
 def export_preset_glb(preset: Preset, material: Material, wavelengths: int = 0) -> bytes:

@@ -76,7 +76,7 @@ def base_colour_and_metallic(material: Material) -> tuple[list[float], float]:
     return [float(c) * min(material.kd, 1.0) for c in material.albedo], 0.0
 
 
-def thickness_png(field: np.ndarray) -> bytes:
+def field_png(field: np.ndarray) -> bytes:
     """The [0, 1] field as a grey RGB PNG, row 0 at the top: Opaline's fields are stored
     with v = 1 on row 0, and the export writes glTF's t = 1 - v, so rows map unchanged."""
     grey = np.round(np.clip(field, 0.0, 1.0) * 255.0).astype(np.uint8)
@@ -85,7 +85,7 @@ def thickness_png(field: np.ndarray) -> bytes:
     return out.getvalue()
 
 
-def add_thickness_texture(document: gl.GLTF2, buffer_view: int) -> int:
+def add_film_texture(document: gl.GLTF2, buffer_view: int) -> int:
     """Image, repeating mipmapped sampler (the fields tile) and texture; the texture's index."""
     document.images.append(gl.Image(bufferView=buffer_view, mimeType="image/png"))
     document.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR,

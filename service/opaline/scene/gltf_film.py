@@ -34,6 +34,16 @@ class FilmTextures:
     thickness: np.ndarray | None  # [0, 1] → [film_thickness_min, film_thickness_max]
     factor: np.ndarray | None  # [0, 1], times iridescenceFactor
 
+    @classmethod
+    def from_keys(cls, fields: dict[str, np.ndarray]) -> FilmTextures:
+        return cls(fields.get("iridescenceThicknessTexture"), fields.get("iridescenceTexture"))
+
+    def by_key(self) -> dict[str, np.ndarray]:
+        """The fields present, by the KHR texture each is (the inverse of ``from_keys``)."""
+        fields = {"iridescenceThicknessTexture": self.thickness,
+                  "iridescenceTexture": self.factor}
+        return {key: field for key, field in fields.items() if field is not None}
+
 
 def load_document(data: bytes) -> gl.GLTF2:
     """A .glb's document; ValueError saying why where the bytes are not one."""
@@ -107,8 +117,7 @@ def read_film_textures(data: bytes, keys: tuple[str, ...] = tuple(CHANNELS)) -> 
     film = _film(document)
     fields = {key: _channel(_image_bytes(document, film[key], key), CHANNELS[key], key)
               for key in keys if key in film}
-    return FilmTextures(fields.get("iridescenceThicknessTexture"),
-                        fields.get("iridescenceTexture"))
+    return FilmTextures.from_keys(fields)
 
 
 def texture_names(head: bytes) -> set[str]:
