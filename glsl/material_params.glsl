@@ -13,14 +13,25 @@ uniform vec3 u_spectral_weight[WAVELENGTHS];
 uniform float u_wavelength_nm[WAVELENGTHS];
 #endif
 #if WAVELENGTHS == 0 && defined(IRIDESCENCE_THIN_FILM)
-uniform vec3 u_film_sens_weight[3];
-uniform vec3 u_film_sens_centre[3];
-uniform vec3 u_film_sens_sigma[3];
+// The fast path's Gaussians per channel (opaline/model/visible.py SENSITIVITY_GAUSSIANS).
+#define FILM_GAUSSIANS 4
+uniform vec3 u_film_sens_weight[FILM_GAUSSIANS];
+uniform vec3 u_film_sens_centre[FILM_GAUSSIANS];
+uniform vec3 u_film_sens_sigma[FILM_GAUSSIANS];
 #endif
 #if defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR) && WAVELENGTHS > 0
 uniform vec2 u_substrate_nk[WAVELENGTHS];
 #elif defined(IRIDESCENCE_THIN_FILM) && defined(SUBSTRATE_CONDUCTOR)
 uniform vec2 u_substrate_nk[3];
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(STACK_PAIRS) && WAVELENGTHS == 0
+// A stack has no closed form over the colour weights: the fast path evaluates it at the
+// bins of lib/thin_film_stack.glsl's STACK_BINS.
+uniform float u_stack_bin_nm[16];
+uniform vec3 u_stack_bin_weight[16];
+#ifdef SUBSTRATE_CONDUCTOR
+uniform vec2 u_stack_bin_nk[16];
+#endif
 #endif
 #if (WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)) && defined(IRIDESCENCE_GRATING)
 uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
@@ -57,6 +68,10 @@ uniform float u_film_thickness_min;
 uniform float u_film_thickness_max;
 #ifdef FILM_WEIGHT
 uniform float u_film_weight;
+#endif
+#ifdef STACK_PAIRS
+uniform float u_stack_spacer_ior;
+uniform float u_stack_spacer_nm;
 #endif
 #endif
 #ifdef IRIDESCENCE_GRATING
@@ -105,6 +120,10 @@ Material material_params() {
     mat.film.thickness_max = u_film_thickness_max;
 #ifdef FILM_WEIGHT
     mat.film.weight = u_film_weight;
+#endif
+#ifdef STACK_PAIRS
+    mat.film.spacer_ior = u_stack_spacer_ior;
+    mat.film.spacer_nm = u_stack_spacer_nm;
 #endif
 #endif
 #ifdef IRIDESCENCE_GRATING

@@ -6,12 +6,13 @@
 // the map's features an order reflects the map's radiance there times its albedo
 //   ∫ η_m·F·D(h_m)·(v·h_m)/(|k_m|²·max(n·l, n·v))·(n·l) dω_l ≈ η_m(λ)·F(n·v)·(n·v)/max(n·l, n·v)
 // (dω_l = |k_m|²/(l·h_m)·dω_h and ∫ D dω_h ≈ 1 about h_m = n), so the map is read at
-// ENV_GRATING_READS points along the curve, each over its stretch Δb of it, and each
-// read lights every order that falls there with the spectrum's weight over the
+// ENV_GRATING_READS pieces of the curve, each at its middle and over its stretch Δb,
+// and each read lights every order that falls there with the spectrum's weight over the
 // wavelengths of that stretch, λ ∈ d·(|b + v_b| ± Δb/2)/m, from the visible density's
 // integral: the same closed form over the spectrum as the fast path's lights
 // (lib/grating.glsl), and a cost that does not grow with the tier's wavelengths. The
-// mirror order is one read. Passes shift the points through their stretches.
+// mirror order is one read. Each pixel and pass cuts the curve at its own offset (fixed
+// cuts drew the pieces' colours as rings), and once more where its two halves join.
 // Float64 twin: opaline/model/grating_environment.py. Included by
 // lib/environment_light.glsl (ENV_GRATING_ORDERS) after env_lookup and env_lod_footprint.
 #ifndef ENVIRONMENT_GRATING_GLSL
@@ -29,7 +30,8 @@ vec3 grating_read(Environment env, realmat3 frame, vec3 l, float nv, float lobe_
 
 // Order m's weight at a stretch of the curve |b + v_b| ∈ q ± half: over each half of its
 // wavelengths, the spectrum's weight times η_m at that half's middle (η changes across a
-// stretch: at one point a stretch, 8 reads were 11 % off under a constant map, at two 3 %).
+// stretch: at one point a stretch, 8 reads cut at offset 0 were 11 % off under a constant
+// map, at two 3 %).
 vec3 grating_stretch(Material mat, int m, float q, float half_q, float kn) {
     float per_nm = mat.grating.pitch_nm / float(m);
     float lo = per_nm * (q - half_q);

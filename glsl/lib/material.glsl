@@ -33,6 +33,10 @@ struct Film {  // lib/thin_film.glsl
 #ifdef FILM_WEIGHT
     float weight;  // KHR iridescenceFactor: mix(bare substrate, film, weight); 1 without
 #endif
+#ifdef STACK_PAIRS
+    float spacer_ior;  // a stack's second layer (lib/thin_film_stack.glsl)
+    float spacer_nm;  // its thickness where the film's is thickness_max
+#endif
 };
 #endif
 #ifdef IRIDESCENCE_GRATING

@@ -9,10 +9,11 @@
 // Float64 twin: opaline/model/thinfilm.py. The film comes in as a Film (mat.film,
 // lib/material.glsl). Contract: the program declares, before this file, the tables
 //   float u_wavelength_nm[WAVELENGTHS];           with WAVELENGTHS > 0
-//   vec3 u_film_sens_weight[3], u_film_sens_centre[3], u_film_sens_sigma[3];
+//   vec3 u_film_sens_weight[FILM_GAUSSIANS], u_film_sens_centre[…], u_film_sens_sigma[…];
 //                                                 with WAVELENGTHS = 0 (see film_rgb)
 //   vec2 u_substrate_nk[WAVELENGTHS, or 3 for R, G, B];  with SUBSTRATE_CONDUCTOR
-// What the surface reflects is film_layer_rgb: the film over its base, by film.weight
+// With STACK_PAIRS the film is a stack of that many periods, each a layer of film.ior over
+// a spacer (lib/thin_film_stack.glsl). What the surface reflects is film_layer_rgb: the film over its base, by film.weight
 // (KHR iridescenceFactor) where FILM_WEIGHT is compiled in (a weight below 1), else the
 // film alone, as before the weight existed.
 #ifndef THIN_FILM_GLSL
@@ -64,7 +65,9 @@ vec3 film_base_rgb(Film film, float cos1) {
     return vec3(cos1 > 0.0 && cos3_sq > 0.0 ? 0.5 * dot(r, r) : 1.0);
 }
 
-#if WAVELENGTHS > 0
+#if defined(STACK_PAIRS)
+// A stack's layers draw the film (lib/thin_film_stack.glsl, included below).
+#elif WAVELENGTHS > 0
 float film_airy(float a, float b, float c) {
     float ab = a * b;
     // The numerator cancels to ~0 where a = -b (no interface): rounding may not go negative.
@@ -93,7 +96,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
 // Fast path (Belcour & Barla 2017): R(φ) = c0 + 2·Σ_m c_m cos(mφ) with
 // c0 = (a² + b² - 2x²)/(1 - x²), c_m = A·q^m, A = -(1-a²)(1-b²)/(1-x²), q = -x,
 // x = ab; each cos(mφ) integrated against the colour weights in closed form from
-// three Gaussians per channel over wavenumber (opaline/model/visible.py):
+// four Gaussians per channel (FILM_GAUSSIANS) over wavenumber (opaline/model/visible.py):
 //   ∫ ŵ cos(2π·m·opd·ν) dν = Σ_k w_k cos(m·θ_k) d_k^(m²),  θ_k = 2π·μ_k·opd,
 //   d_k = exp(-2(π·σ_k·opd)²).
 // The three terms are evaluated from one cosine and one exponential per Gaussian
@@ -123,7 +126,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
     float w3 = dot(amp, q2 * q);
     vec2 tail4 = amp * q2 * q2;  // A·q⁴ per polarisation
     vec3 rgb = vec3(0.5 * (c0.x + c0.y));
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < FILM_GAUSSIANS; ++k) {
         vec3 c1 = cos(TWO_PI * fract(u_film_sens_centre[k] * opd_um));
         vec3 c2 = 2.0 * c1 * c1 - 1.0;
         vec3 c3 = c1 * (2.0 * c2 - 1.0);
@@ -146,6 +149,9 @@ vec3 film_rgb(Film film, float cos1, float d) {
 }
 #endif  // WAVELENGTHS
 #endif  // SUBSTRATE_CONDUCTOR
+#ifdef STACK_PAIRS
+#include "lib/thin_film_stack.glsl"
+#endif
 
 // KHR_materials_iridescence's layering: the film's reflectance mixed with its base's by
 // the weight (the Sample Viewer mixes the two Fresnel terms by iridescenceFactor). Without

@@ -9,25 +9,7 @@
 #ifndef THIN_FILM_CONDUCTOR_GLSL
 #define THIN_FILM_CONDUCTOR_GLSL
 
-vec2 c_mul(vec2 a, vec2 b) {
-    return vec2(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
-}
-
-vec2 c_div(vec2 a, vec2 b) {
-    return c_mul(a, vec2(b.x, -b.y)) / max(dot(b, b), 1e-30);
-}
-
-// Principal square root: Re ≥ 0, and Im ≥ 0 where Im z ≥ 0 (k ≥ 0: the wave decays
-// into the metal). The smaller part is found by division, not by cancellation.
-vec2 c_sqrt(vec2 z) {
-    float r = length(z);
-    if (z.x >= 0.0) {
-        float re = sqrt(0.5 * (r + z.x));
-        return vec2(re, re > 0.0 ? 0.5 * z.y / re : 0.0);
-    }
-    float im = sqrt(0.5 * (r - z.x));
-    return vec2(0.5 * abs(z.y) / im, z.y < 0.0 ? -im : im);
-}
+#include "lib/complex.glsl"
 
 // The film's top interface (s, p), as film_interfaces; false where light cannot enter,
 // and exactly at grazing, where all is reflected (over a lossless ñ = 1 Airy is 0/0).
@@ -81,6 +63,7 @@ vec3 film_base_rgb(Film film, float cos1) {
     return max(sum, vec3(0.0));
 }
 
+#ifndef STACK_PAIRS  // a stack's layers draw the film instead (lib/thin_film_stack.glsl)
 vec3 film_rgb(Film film, float cos1, float d) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float cos2;
@@ -100,6 +83,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
     }
     return max(sum, vec3(0.0));
 }
+#endif
 #else
 // Fast path: the dielectric's Fourier series (lib/thin_film.glsl) per channel, with
 // one n + ik per channel (its colour weight's average) and so one complex b per
@@ -119,7 +103,7 @@ float film_channel(int c, float nf, float cos1, float cos2, vec2 r12, float opd_
         float one_minus = max(1.0 - q * q, 1e-30);
         float amp = -(1.0 - a * a) * (1.0 - b_abs * b_abs) / one_minus;
         value += 0.5 * (a * a + b_abs * b_abs - 2.0 * q * q) / one_minus;
-        for (int k = 0; k < 3; ++k) {
+        for (int k = 0; k < FILM_GAUSSIANS; ++k) {
             float c1 = cos(TWO_PI * fract(u_film_sens_centre[k][c] * opd_um) + psi);
             float c2 = 2.0 * c1 * c1 - 1.0;
             float c3 = c1 * (2.0 * c2 - 1.0);
@@ -145,6 +129,7 @@ vec3 film_base_rgb(Film film, float cos1) {
                 film_bare_conductor(cos1, u_substrate_nk[2]));
 }
 
+#ifndef STACK_PAIRS  // a stack's layers draw the film instead (lib/thin_film_stack.glsl)
 vec3 film_rgb(Film film, float cos1, float d) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float cos2;
@@ -158,6 +143,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
                     film_channel(2, film.ior, cos1, cos2, r12, opd_um));
     return max(rgb, vec3(0.0));
 }
+#endif
 #endif
 
 #endif

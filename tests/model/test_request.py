@@ -75,6 +75,25 @@ def test_tier_fills_samples_wavelengths_aa(tier):
         TIERS[tier].samples, TIERS[tier].wavelengths, TIERS[tier].aa)
 
 
+@pytest.mark.parametrize("tier", sorted(TIERS))
+def test_a_film_takes_its_own_wavelengths_from_the_tier(tier):
+    """Per colour source (bench/white_point.py): a film on a dielectric takes the tier's
+    film_wavelengths (the fast path at draft and standard), on a metal its
+    metal_film_wavelengths; the rotation keeps wavelengths; a request's own value wins."""
+    want = TIERS[tier]
+    film = resolve(RenderRequest(preset="oil-film", quality=tier))
+    metal = resolve(RenderRequest(preset="tempered-steel", quality=tier))
+    rotation = resolve(RenderRequest(preset="sphere", quality=tier))
+    assert film.wavelengths == want.film_wavelengths
+    assert metal.wavelengths == want.metal_film_wavelengths
+    assert rotation.wavelengths == want.wavelengths
+    assert resolve(RenderRequest(preset="oil-film", quality=tier, wavelengths=24)).wavelengths == 24
+    assert resolve(RenderRequest(preset="sphere", quality=tier, iridescence="thin-film")
+                   ).wavelengths == want.film_wavelengths
+    assert TIERS["draft"].film_wavelengths == 0 and TIERS["standard"].film_wavelengths == 0
+    assert TIERS["standard"].metal_film_wavelengths == 16
+
+
 def test_tiers_are_ordered():
     """Tiers are the four of docs/design.md §8, samples growing toward a spectral reference."""
     assert list(TIERS) == ["draft", "standard", "high", "reference"]
@@ -148,6 +167,7 @@ CHANGED_MATERIAL = {
     "film_thickness_max": 420.0, "substrate_ior": 1.33, "grating_pitch": 0.74,
     "grating_orders": 2, "grating_depth": 120.0, "substrate": "conductor", "metal": "artist",
     "metal_f0": (0.9, 0.6, 0.3), "metal_edge_tint": (1.0, 0.9, 0.8), "film_weight": 0.5,
+    "film_stack_pairs": 3, "film_spacer_ior": 1.2, "film_spacer_thickness": 90.0,
 }
 
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from opaline.gl import heightfield
 from opaline.gl.uniforms import Uniforms
-from opaline.model import grating, metals, visible
+from opaline.model import grating, metals, stack_film, visible
 from opaline.model.params import Material
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -82,6 +82,8 @@ def material_defines(material: Material, wavelengths: int = 0, aa: str = "none")
         defines["SUBSTRATE_CONDUCTOR"] = True
     if has_film_weight(material):
         defines["FILM_WEIGHT"] = True
+    if stack_film.is_stack(material):
+        defines["STACK_PAIRS"] = material.film_stack_pairs
     return defines
 
 
@@ -166,6 +168,8 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
     if is_conductor(material):
         nk = np.atleast_1d(metals.substrate_for(material, wavelengths))
         values["u_substrate_nk"] = [(float(x.real), float(x.imag)) for x in nk]
+    if stack_film.is_stack(material):
+        values.update(_stack_uniforms(material, wavelengths))
     if wavelengths > 0:
         values["u_wavelength_nm"] = [float(x) for x in sample_wavelengths(wavelengths)]
     else:
@@ -176,4 +180,18 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
         values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
         values["u_visible_cumulative"] = [tuple(row) for row in visible.cumulative_table()]
         values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
+    return values
+
+
+def _stack_uniforms(material: Material, wavelengths: int) -> Uniforms:
+    """The spacer, and on the fast path the bins the stack is integrated over."""
+    values: Uniforms = {"u_stack_spacer_ior": material.film_spacer_ior,
+                        "u_stack_spacer_nm": material.film_spacer_thickness}
+    if wavelengths == 0:
+        bins = stack_film.STACK_BINS
+        values["u_stack_bin_nm"] = [float(x) for x in sample_wavelengths(bins)]
+        values["u_stack_bin_weight"] = [tuple(w) for w in rgb_weights(bins)]
+        if is_conductor(material):
+            nk = np.atleast_1d(stack_film.bin_substrate(material, 0))
+            values["u_stack_bin_nk"] = [(float(x.real), float(x.imag)) for x in nk]
     return values

@@ -45,6 +45,9 @@ SubstrateIor = Annotated[float, Field(ge=1.0, le=4.0)]
 # Thickness in nm: 0 is the bare substrate; beyond ~2 µm the colours of a film
 # wash out to white within the 3 nm spectral sampling.
 Thickness = Annotated[float, Field(ge=0.0, le=2000.0)]
+# A stack's periods: 16 pairs are 32 layers, model.multilayer.MAX_LAYERS.
+MAX_STACK_PAIRS = 16
+StackPairs = Annotated[int, Field(ge=0, le=MAX_STACK_PAIRS)]
 # Pitch in µm: 0.2 (no visible first order below) to 20 (orders crowd the specular).
 Pitch = Annotated[float, Field(ge=0.2, le=20.0)]
 Orders = Annotated[int, Field(ge=1, le=8)]
@@ -94,6 +97,20 @@ class Material(BaseModel):
         400.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=FILM),
         description="Film thickness in nm where the thickness field is 1, and everywhere "
         "without a field (KHR iridescenceThicknessMaximum), 0 … 2000.")
+    film_stack_pairs: StackPairs = Field(
+        0, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="Periods of a multilayer stack, 0 … 16: 0 is the single film; N > 0 makes "
+        "the film N pairs of layers on the substrate, each the film's layer (film_ior, its "
+        "thickness) over a spacer (film_spacer_ior, film_spacer_thickness): a Bragg mirror, "
+        "a Morpho scale's lamellae. A thickness field scales both layers.")
+    film_spacer_ior: FilmIor = Field(
+        1.46, json_schema_extra=about(PHYSICAL, iridescence=FILM),
+        description="A stack's spacer layer's refractive index (silica 1.46, air 1 between "
+        "a wing scale's lamellae), 1 … 3; read where film_stack_pairs > 0.")
+    film_spacer_thickness: Thickness = Field(
+        100.0, json_schema_extra=about(PHYSICAL, "nm", iridescence=FILM),
+        description="A stack's spacer thickness in nm where the film's is "
+        "film_thickness_max, 0 … 2000; read where film_stack_pairs > 0.")
     substrate_ior: SubstrateIor = Field(
         1.5, json_schema_extra=about(PHYSICAL, iridescence=FILM, substrate=DIELECTRIC),
         description="Refractive index under the film (water 1.33, glass 1.5, air 1 for a "

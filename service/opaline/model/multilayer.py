@@ -55,9 +55,11 @@ class StackOptics:
         return result
 
 
-def _normal_component(index: np.ndarray, sin0_n0: np.ndarray) -> np.ndarray:
-    """q = Ñ·cos θ = √(Ñ² − (n₀ sin θ₀)²), the root with Im ≥ 0 (decaying into the medium)."""
-    q = np.sqrt(index.astype(np.complex128) ** 2 - sin0_n0**2)
+def _normal_component(index: np.ndarray, ambient: float, cos0: np.ndarray) -> np.ndarray:
+    """q = Ñ·cos θ = √(Ñ² − (n₀ sin θ₀)²), the root with Im ≥ 0 (decaying into the medium),
+    as √((Ñ² − n₀²) + n₀²·cos²θ₀): near grazing 1 − cos²θ₀ rounds to 1, which would make a
+    layer of the ambient's index (n = 1 in air) reflect totally."""
+    q = np.sqrt((index.astype(np.complex128) ** 2 - ambient**2) + (ambient * cos0) ** 2)
     result: np.ndarray = np.where(q.imag < 0.0, -q, q)
     return result
 
@@ -65,10 +67,11 @@ def _normal_component(index: np.ndarray, sin0_n0: np.ndarray) -> np.ndarray:
 def stack_optics(layers: Sequence[complex | npt.ArrayLike], thicknesses_nm: npt.ArrayLike,
                  wavelength_nm: npt.ArrayLike,
                  cos0: npt.ArrayLike = 1.0, ambient: float = 1.0,
-                 substrate: complex = 1.0) -> StackOptics:
+                 substrate: complex | npt.ArrayLike = 1.0) -> StackOptics:
     """R and T of ``layers`` (indices, the ambient's side first; each a number or one per
     wavelength along the last axis of ``wavelength_nm``'s shape) of ``thicknesses_nm``,
-    between a lossless ``ambient`` and a ``substrate``, lit at cos θ₀ = ``cos0``."""
+    between a lossless ``ambient`` and a ``substrate`` (a number or one per wavelength),
+    lit at cos θ₀ = ``cos0``."""
     lam = np.asarray(wavelength_nm, dtype=np.float64)
     cos0 = np.asarray(cos0, dtype=np.float64)
     thicknesses = np.asarray(thicknesses_nm, dtype=np.float64)
@@ -76,15 +79,14 @@ def stack_optics(layers: Sequence[complex | npt.ArrayLike], thicknesses_nm: npt.
     if len(indices) != len(thicknesses) or len(indices) > MAX_LAYERS:
         raise ValueError(f"{len(indices)} layers and {len(thicknesses)} thicknesses: one "
                          f"thickness a layer, at most {MAX_LAYERS} layers")
-    sin0_n0 = ambient * np.sqrt(np.maximum(1.0 - cos0**2, 0.0))
     eta0_s, eta0_p = ambient * cos0, ambient / np.maximum(cos0, 1e-300)
-    q_sub = _normal_component(np.asarray(substrate), sin0_n0)
+    q_sub = _normal_component(np.asarray(substrate), ambient, cos0)
     optics = {}
     for name, eta0 in (("s", eta0_s), ("p", eta0_p)):
         eta_sub = q_sub if name == "s" else np.asarray(substrate) ** 2 / q_sub
         b, c = np.ones_like(q_sub * lam), eta_sub * np.ones_like(lam)
         for index, d in zip(reversed(indices), reversed(thicknesses), strict=True):
-            q = _normal_component(index, sin0_n0)
+            q = _normal_component(index, ambient, cos0)
             eta = q if name == "s" else index**2 / q
             delta = 2.0 * np.pi * q * d / lam
             cos_d, sin_d = np.cos(delta), np.sin(delta)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from opaline.model import grating, metals, thinfilm
+from opaline.model import grating, metals, stack_film, thinfilm
 from opaline.model.microfacet import EPS_DENOM, EPS_HALF, FloatArray, Frame, mdf_ashikhmin
 
 if TYPE_CHECKING:
@@ -43,9 +43,12 @@ def specular_thin_film(
     nl = np.sum(n * l, axis=-1)
     nv = np.sum(n * v, axis=-1)
     thickness = material.film_thickness_max if thickness_nm is None else thickness_nm
-    substrate = metals.substrate_for(material, wavelengths)
-    film = thinfilm.film_layer_rgb(vh, thickness, material.film_ior, substrate,
-                                   material.film_weight, wavelengths)
+    if stack_film.is_stack(material):
+        film = stack_film.stack_layer_rgb(material, vh, thickness, wavelengths)
+    else:
+        substrate = metals.substrate_for(material, wavelengths)
+        film = thinfilm.film_layer_rgb(vh, thickness, material.film_ior, substrate,
+                                       material.film_weight, wavelengths)
     denom = 4.0 * np.maximum(vh, EPS_DENOM) * np.maximum(np.maximum(nl, nv), EPS_DENOM)
     spec = material.ks * film * (d / denom)[..., None]
     return np.where(length > EPS_HALF, spec, 0.0)

@@ -11,7 +11,9 @@ KHR_materials_ior) whose colour is the metal's bare F0, which KHR viewers use as
 the metal's reflectance under the film; a metallic file imports back as the
 ``artist`` metal of that F0 (edge tint white). A preset's thickness field is written as
 iridescenceThicknessTexture: 8-bit grey RGB (KHR reads G), 1/255 of the range
-per step; a user's .glb's own textures go back as they came (scene.gltf_film).
+per step; a user's .glb's own textures go back as they came (scene.gltf_film). A stack
+(film_stack_pairs > 0) is not a KHR film: it is written without the extension, in the
+extras only.
 
 Import reads the same names back, iridescenceFactor into film_weight (a factor of 0,
 no film, is refused: that is a plain material), with the extension's defaults (ior
@@ -46,7 +48,9 @@ F0_WAVELENGTHS = 128  # a conductor's base colour: its bare F0, converged (docs/
 
 
 def is_thin_film(material: Material) -> bool:
-    return material.iridescence == "thin-film"
+    """A film KHR_materials_iridescence can say: one layer. A stack (film_stack_pairs > 0)
+    has no KHR form; its .glb carries it in extras.opaline alone, which Opaline imports."""
+    return material.iridescence == "thin-film" and material.film_stack_pairs == 0
 
 
 def thin_film_extensions(material: Material, textures: dict[str, int]) -> dict[str, Any]:

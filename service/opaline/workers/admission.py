@@ -137,14 +137,16 @@ class CostModel:
                                for k, c in self.labels.items()}}
 
 
-def shading_index(iridescence: str, orders: int) -> float:
+def shading_index(iridescence: str, orders: int, stack_pairs: int = 0) -> float:
     """Shading cost per pixel-sample-wavelength over the paper's rotations', measured on
     llvmpipe at 0, 16 and 128 wavelengths: a thin film 0.5-1.8× (dearest without
     wavelengths, where it is cheap), a grating of m orders 2.3-3.3× (m = 1), 4.1-5.4× (3),
-    6.6-10× (8); the safety factor covers the spread."""
+    6.6-10× (8); the safety factor covers the spread. A stack of N pairs, over the single
+    film (oil-film, draft, one sample, at 0, 16 and 64 wavelengths): 1.4-1.8× (N = 1),
+    2.2-3.8× (4), 8.8-15.6× (16), inside 1 + N."""
     if iridescence == "grating":
         return 2.0 + orders
-    return 1.25 if iridescence == "thin-film" else 1.0
+    return 1.25 * (1 + stack_pairs) if iridescence == "thin-film" else 1.0
 
 
 def mesh_cost_s(size_bytes: int, max_triangles: int, passes: int) -> float:

@@ -69,7 +69,8 @@ class ImageTask:
         compile (``CostModel.predict_task``); a define a numeric field switches is missed."""
         job = self.prepared.job
         material = tuple(sorted((k, v) for k, v in job.material.model_dump().items()
-                                if isinstance(v, (str, bool)) or k == "grating_orders"))
+                                if isinstance(v, (str, bool))
+                                or k in ("grating_orders", "film_stack_pairs")))
         return (self.prepared.preset.name, self.prepared.preset.geometry.args.get("path"),
                 job.wavelengths, job.samples, job.aa, job.tonemap, job.transparent,
                 job.environment, job.environment_lights, job.environment_samples,
@@ -83,9 +84,12 @@ class ImageTask:
         # Calibrated on the preset's own material: a costlier source or more orders scale
         # it up (never down: the calibration is the floor).
         own = preset_fields(preset)
-        units *= max(1.0, shading_index(job.material.iridescence, job.material.grating_orders)
+        material = job.material
+        units *= max(1.0, shading_index(material.iridescence, material.grating_orders,
+                                        material.film_stack_pairs)
                      / shading_index(own.get("iridescence") or "rotation",
-                                     own.get("grating_orders") or 3))
+                                     own.get("grating_orders") or 3,
+                                     own.get("film_stack_pairs") or 0))
         return preset.name, units, job.wavelengths, self._mesh_s()
 
     def _mesh_s(self) -> float:
