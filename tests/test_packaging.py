@@ -159,7 +159,7 @@ def test_fresh_venv_install_runs_every_entry_point(wheel, tmp_path):
 
     opaline = str(bin_dir / "opaline")
     if "--version" in run(opaline, "--help").stdout.decode():
-        assert "0.1.0" in run(opaline, "--version").stdout.decode()
+        assert "0.2.0" in run(opaline, "--version").stdout.decode()
 
     small = ("--size", "64x64", "--quality", "draft")
     run(opaline, "render", "cd-rom", "-o", "out.png", *small)

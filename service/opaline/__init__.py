@@ -6,7 +6,7 @@ imported on first use so that importing the package stays light.
 
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 __all__ = ["__version__", "export_material", "render", "render_array", "render_turntable"]
 
 if TYPE_CHECKING:  # type checkers see the real signatures; at run time they load lazily

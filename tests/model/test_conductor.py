@@ -135,8 +135,8 @@ def test_artist_metal_at_the_channels_is_its_f0():
 
 
 # Linear sRGB F0 of gold and copper as Real-Time Rendering (4th ed., Table 9.2,
-# after Hoffman) lists them, from measured spectra; these tables differ from its data
-# by up to 0.05 (sources, equal-energy white here).
+# after Hoffman) lists them, from measured spectra; these tables under D65 differ from
+# its data by up to 0.054 (gold's green: the n, k sources differ).
 PUBLISHED_F0 = {"gold": (1.000, 0.782, 0.344), "copper": (0.955, 0.638, 0.538)}
 
 
@@ -146,17 +146,17 @@ def test_bare_metal_colour_is_the_published_f0(name):
                         film_thickness_max=0.0)
     spectral = thinfilm.film_rgb(1.0, 0.0, 1.5, metals.substrate_for(material, 128), 128)
     fast = thinfilm.film_rgb(1.0, 0.0, 1.5, metals.substrate_for(material, 0), 0)
-    assert np.abs(spectral - PUBLISHED_F0[name]).max() < 0.05
+    assert np.abs(spectral - PUBLISHED_F0[name]).max() < 0.06
     assert np.abs(fast - PUBLISHED_F0[name]).max() < 0.07
     assert spectral[0] > spectral[1] > spectral[2]  # warm: red, then green, least blue
 
 
-@pytest.mark.parametrize(("name", "mean_bound"), [("gold", 0.03), ("copper", 0.02),
+@pytest.mark.parametrize(("name", "mean_bound"), [("gold", 0.035), ("copper", 0.027),
                                                   ("titanium", 0.006), ("iron", 0.006)])
 def test_fast_path_against_the_spectral_path(name, mean_bound):
     """The measured mean |fast - spectral(256)| in linear RGB over films 0-600 nm of
-    index 1.5 and 2.4 at v·h 0.05-1 (docs/physics.md §1.2): gold 0.021/0.026, copper
-    0.012/0.018, titanium 0.002/0.004, iron 0.002/0.003."""
+    index 1.5 and 2.4 at v·h 0.05-1 (docs/physics.md §1.2), under D65: gold 0.026/0.032,
+    copper 0.016/0.024, titanium 0.002/0.004, iron 0.001/0.002."""
     cos1, d = np.meshgrid(np.linspace(0.05, 1.0, 20), np.linspace(0.0, 600.0, 61))
     material = Material(iridescence="thin-film", substrate="conductor", metal=name)
     for n_film in (1.5, 2.4):

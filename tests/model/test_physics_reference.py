@@ -127,7 +127,7 @@ def test_fit_reproduces_the_colour_weights():
     model = sum(
         g[k, :, 0] / (g[k, :, 2] * np.sqrt(2 * np.pi))
         * np.exp(-((nu[:, None] - g[k, :, 1]) ** 2) / (2 * g[k, :, 2] ** 2))
-        for k in range(3)
+        for k in range(g.shape[0])
     )
     assert np.all(np.abs(model - per_nu).max(axis=0) < 0.03 * per_nu.max(axis=0))
 

@@ -55,9 +55,11 @@ def test_weights_are_white_balanced_and_shared_read_only(count):
 
 
 def test_shipped_cmfs_are_colour_sciences():
-    """The CIE 1931 table shipped with the package gives colour-science's interpolated values
-    (to 1e-5; the weights to 2e-6) at any wavelength. Regenerate the file with:
-    np.save(path, column_stack([lam, MSDS_CMFS[...][lam]])) for lam = 360 … 830 by 0.1 nm."""
+    """The CIE 1931 table and D65 shipped with the package give colour-science's values
+    (to 1e-5; D65 at its own 5 nm steps exactly, between them linearly as CIE recommends;
+    the weights, CMFs under D65, to 2e-6) at any wavelength. Regenerate the files with:
+    np.save(path, column_stack([lam, MSDS_CMFS[...][lam]])) for lam = 360 … 830 by 0.1 nm;
+    np.save(path, column_stack([lam, SDS_ILLUMINANTS["D65"][lam]])) for lam = 300 … 780 by 5."""
     import colour
     import numpy as np
 
@@ -67,8 +69,15 @@ def test_shipped_cmfs_are_colour_sciences():
     lam = np.random.default_rng(7).uniform(380.0, 780.0, 500)
     assert np.abs(spectrum.cie_xyz(lam) - np.asarray(cmfs[lam])).max() < 1e-5
     assert np.allclose(spectrum.XYZ_TO_SRGB, colour.models.RGB_COLOURSPACE_sRGB.matrix_XYZ_to_RGB)
+    d65 = colour.SDS_ILLUMINANTS["D65"]
+    steps = np.arange(300.0, 781.0, 5.0)
+    assert np.array_equal(spectrum.illuminant_d65(steps), np.asarray(d65[steps]))
     for count, shift in ((4, 0.5), (16, 0.123), (128, 0.9)):
-        rgb = np.asarray(cmfs[spectrum.sample_wavelengths(count, shift)]) @ spectrum.XYZ_TO_SRGB.T
+        lam = spectrum.sample_wavelengths(count, shift)
+        d65_linear = colour.SpectralDistribution(d65).interpolate(
+            colour.SpectralShape(300.0, 780.0, 0.1), interpolator=colour.LinearInterpolator)
+        lit = np.asarray(cmfs[lam]) * np.asarray(d65_linear[lam])[:, None]
+        rgb = lit @ spectrum.XYZ_TO_SRGB.T
         expected = rgb / rgb.sum(axis=0, keepdims=True)
         assert np.abs(spectrum.rgb_weights(count, shift) - expected).max() < 2e-6
 

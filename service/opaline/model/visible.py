@@ -1,7 +1,7 @@
 """The visible spectrum as continuous colour weights, for the fast RGB paths.
 
 The spectral paths sum per-wavelength values with ``spectrum.rgb_weights``: CIE
-1931 2° colour matching functions taken to linear sRGB and white balanced so a
+1931 2° colour matching functions under D65 taken to linear sRGB, normalised so a
 flat spectrum gives R = G = B. The fast paths need the same weights as
 *densities* (per nm, or per µm⁻¹ of wavenumber) so that an integral can be done
 in closed form:
@@ -9,12 +9,13 @@ in closed form:
 - ``density_table``: ŵ_c(λ) per nm on a 5 nm grid, each channel integrating to
   1 over 380-780 nm; the grating's fast path reads it at the wavelength an
   order diffracts toward the viewer (Stam 1999's idea).
-- ``SENSITIVITY``: ŵ_c(ν) over wavenumber ν = 1/λ (µm⁻¹) as three Gaussians per
-  channel, fitted once (least squares, worst error 2-3 % of each peak) by the
+- ``SENSITIVITY``: ŵ_c(ν) over wavenumber ν = 1/λ (µm⁻¹) as four Gaussians per
+  channel, fitted once (bench/fit_sensitivity.py, worst error 1.1-2.1 % of each
+  peak; three reached 3.4 % under D65, whose spectrum has a dip at 590 nm) by the
   method of Belcour & Barla 2017: the Fourier transform of a Gaussian is a
   Gaussian, so ∫ ŵ_c(ν) cos(2π·OPD·ν + s) dν has a closed form, which is what
   lets a thin film's spectral integral be evaluated without wavelengths. Fitted
-  to our own white-balanced sRGB weights (not XYZ), so the fast path converges
+  to our own sRGB weights under D65 (not XYZ), so the fast path converges
   to the spectral one where the film's colour is flat.
 """
 
@@ -26,24 +27,41 @@ import numpy as np
 import numpy.typing as npt
 
 from opaline.model.microfacet import Values
-from opaline.model.spectrum import RANGE_NM, XYZ_TO_SRGB, cie_xyz
+from opaline.model.spectrum import RANGE_NM, XYZ_TO_SRGB, white_xyz
 
 TABLE_STEP_NM = 5.0
 TABLE_SIZE = int((RANGE_NM[1] - RANGE_NM[0]) / TABLE_STEP_NM) + 1  # 81 entries, both ends
 
-# (amplitude, centre µm⁻¹, sigma µm⁻¹) per Gaussian, three per channel R, G, B.
+# (amplitude, centre µm⁻¹, sigma µm⁻¹) per Gaussian, four per channel R, G, B: fitted by
+# bench/fit_sensitivity.py.
+SENSITIVITY_GAUSSIANS = 4
 _FIT = np.array(
     [
-        [[-1.88797, 1.92344, 0.09143], [0.36209, 2.29094, 0.06470], [7.19224, 1.64947, 0.07647]],
-        [[-1.18006, 1.62690, 0.06536], [4.43477, 1.83431, 0.11592], [-0.44305, 2.26653, 0.08333]],
-        [[3.99580, 2.20599, 0.10622], [-0.55083, 1.79592, 0.10334], [0.72614, 2.31818, 0.04133]],
+        [
+            [-2.64147, 1.87996, 0.12551],
+            [0.47325, 2.27150, 0.06847],
+            [8.06440, 1.64967, 0.07239],
+            [1.89804, 1.77529, 0.05809],
+        ],
+        [
+            [-1.85212, 1.65045, 0.08108],
+            [4.39347, 1.81480, 0.13017],
+            [-0.46885, 2.25018, 0.08173],
+            [0.39741, 1.89572, 0.04441],
+        ],
+        [
+            [0.41451, 2.01612, 0.06438],
+            [-0.50980, 1.81318, 0.11088],
+            [3.83310, 2.22823, 0.09604],
+            [1.00996, 2.13971, 0.05945],
+        ],
     ]
 )
 
 
 def _fine_density() -> tuple[np.ndarray, np.ndarray]:
     lam = np.arange(RANGE_NM[0], RANGE_NM[1] + 0.5, 1.0)
-    rgb = cie_xyz(lam) @ XYZ_TO_SRGB.T
+    rgb = white_xyz(lam) @ XYZ_TO_SRGB.T
     return lam, rgb / np.trapezoid(rgb, lam, axis=0)
 
 
