@@ -78,10 +78,13 @@ class Bench:
 
 
 def cache_path(preset, material, size: int, samples: int, wavelengths: int) -> Path:
+    from opaline import __version__
     from opaline.resources import sources_digest
 
+    # The version too: the colour weights (D65 since 0.2.0) live in Python, not the shaders.
     key = json.dumps({"scene": preset.scene_key(), "material": material.model_dump(mode="json"),
-                      "size": size, "shaders": sources_digest()}, sort_keys=True)
+                      "size": size, "shaders": sources_digest(), "version": __version__},
+                     sort_keys=True)
     digest = hashlib.sha256(key.encode()).hexdigest()[:12]
     return RESULTS / f"{preset.name}-{size}-{samples}x{wavelengths}-{digest}.npy"
 

@@ -112,7 +112,10 @@ class RenderFields(MaterialFields, SceneFields):
     wavelengths: int | None = Field(
         None,
         json_schema_extra=wavelengths_schema,
-        description="0 = the paper's RGB rotations, else 4 … 128 wavelengths integrated with CIE 1931 (default: the tier's).",
+        description="0 = the paper's RGB rotations (a film's RGB fast path), else 4 … 128 "
+        "wavelengths integrated with CIE 1931 under D65 (default: the tier's; a thin film "
+        "takes the tier's film_wavelengths, on a metal its metal_film_wavelengths: "
+        "GET /v1/tiers).",
     )
     aa: AntiAlias | None = Field(
         None,

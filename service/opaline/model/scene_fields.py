@@ -14,6 +14,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from opaline.model.tiers import TIERS
 from opaline.scene.environments import BUILTIN, MESH_ENVIRONMENT, NO_ENVIRONMENT
 
 TangentField = Literal["auto", "uv", "concentric", "projected"]
@@ -22,6 +23,11 @@ Finite3 = tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field
 MESH_FIELDS = ("mesh", "tangent_field", "tangent_axis")
 ORBIT_FIELDS = ("camera_azimuth", "camera_elevation", "camera_distance")
 BUILT_IN = ", ".join(f"'{name}'" for name in BUILTIN)
+
+
+def _per_tier(setting: str) -> str:
+    """A tier setting's values as the help states them: "draft 2, standard 6, …"."""
+    return ", ".join(f"{name} {getattr(tier, setting)}" for name, tier in TIERS.items())
 
 
 class SceneFields(BaseModel):
@@ -62,8 +68,8 @@ class SceneFields(BaseModel):
         None, description="Light the scene with an environment instead of the preset's lights: "
                           f"{BUILT_IN}, or an .hdr/.exr file of the environments folder; "
                           f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: the "
-                          "preset's (none on most; studio on soap-bubble and the films on "
-                          f"metals), '{MESH_ENVIRONMENT}' on a user's mesh.",
+                          "preset's (none on most; studio on soap-bubble, the films on "
+                          f"metals and the stacks), '{MESH_ENVIRONMENT}' on a user's mesh.",
         examples=[*BUILTIN, NO_ENVIRONMENT])
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Turns the environment about the up axis, degrees (default 0).")
@@ -77,11 +83,12 @@ class SceneFields(BaseModel):
                           "reference 64).")
     environment_samples: Annotated[int, Field(ge=1, le=4096)] | None = Field(
         None, description="Directions drawn from the material's lobe per pixel to read the "
-                          "environment map, 1 … 4096 (default: the tier's: draft 2, standard "
-                          "6, high 64, reference 1024; for the rotation source's "
-                          "Ashikhmin-Shirley lobes draft 3, standard 9; for a grating, the "
-                          "reads along the curve its orders leave by, draft 2, standard 3, "
-                          "high 32, reference 512). The spectral "
+                          "environment map, 1 … 4096 (default: the tier's: "
+                          f"{_per_tier('environment_samples')}; for the rotation source's "
+                          "Ashikhmin-Shirley lobes "
+                          f"{_per_tier('environment_samples_rotation')}; for a grating, the "
+                          "reads along the curve its orders leave by, "
+                          f"{_per_tier('environment_samples_grating')}). The spectral "
                           "multi-peak lobe reads its envelope from the map's irradiance and "
                           "takes these only for its bands: at most one a pass per 4 "
                           "wavelengths, and none where `samples` (not this field) are too few "
