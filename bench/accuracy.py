@@ -86,16 +86,14 @@ OLD_DRAFT = (1, 0, "analytic")
 
 def time_tiers(bench: Bench, names: list[str]) -> dict[str, dict[str, float]]:
     """Per preset, each tier's (and the old draft's) time over draft's, in alternating pairs."""
+    from accuracy_front import tier_setting
     from opaline.model.presets import all_presets
-    from opaline.model.tiers import TIERS
-
-    def point(tier: str) -> tuple:
-        return tuple(getattr(TIERS[tier], k) for k in ("samples", "wavelengths", "aa"))
 
     out = {}
     for name in names:
         found = paired_ratios(bench, all_presets()[name],
-                              [OLD_DRAFT, point("standard"), point("high")], point("draft"),
+                              [OLD_DRAFT, tier_setting(name, "standard"),
+                               tier_setting(name, "high")], tier_setting(name, "draft"),
                               pairs=7)
         out[name] = dict(zip(("old draft", "standard", "high"), found.values(), strict=True))
         print(f"{name}: {out[name]}", file=sys.stderr, flush=True)

@@ -29,14 +29,24 @@ def best_within(rows: list[dict], key: str, ms: float) -> float:
     return min((r[key] for r in rows if r["ms"] <= ms), default=float("inf"))
 
 
-def tier_point(rows: list[dict], tier: str) -> dict | None:
-    from opaline.model.tiers import TIERS
+def tier_setting(preset: str, tier: str) -> tuple[int, int, str]:
+    """(samples, wavelengths, aa) a request for ``tier`` on ``preset`` resolves to: a
+    film's wavelengths are the tier's for its colour source (model/tiers.py)."""
+    from opaline.model.params import RenderRequest
+    from opaline.model.request import resolve
 
-    want = TIERS[tier]
+    job = resolve(RenderRequest(preset=preset, quality=tier))
+    return job.samples, job.wavelengths, job.aa
+
+
+def tier_point(rows: list[dict], tier: str) -> dict | None:
+    if not rows:
+        return None
+    samples, wavelengths, want_aa = tier_setting(rows[0]["preset"], tier)
     # "analytic" compiles nothing for the Ashikhmin-Shirley MDF: its image is aa none's.
-    for aa in (want.aa, "none"):
-        found = next((r for r in rows if r["samples"] == want.samples
-                      and r["wavelengths"] == want.wavelengths and r["aa"] == aa), None)
+    for aa in (want_aa, "none"):
+        found = next((r for r in rows if r["samples"] == samples
+                      and r["wavelengths"] == wavelengths and r["aa"] == aa), None)
         if found is not None:
             return found
     return None

@@ -37,6 +37,13 @@ CASES = [
     ("sphere", {"light_azimuth": -0.0, "light_elevation": 12.5, "tonemap": "aces"}),
     ("sphere", {"environment": "sky", "environment_rotation": 90.0,
                 "environment_lights": 4, "width": 64, "height": 48}),
+    # A film takes its own wavelengths from the tier (0 at standard on a dielectric, 16 on
+    # a metal): the tier's own value is dropped, the rotation's spelt.
+    ("oil-film", {"quality": "standard", "wavelengths": 0}),
+    ("oil-film", {"quality": "standard", "wavelengths": 16}),
+    ("oil-film", {"quality": "standard", "substrate": "conductor", "wavelengths": 16}),
+    ("sphere", {"iridescence": "thin-film", "wavelengths": 0}),
+    ("tempered-steel", {"quality": "draft", "wavelengths": 0, "substrate": "dielectric"}),
 ]
 
 

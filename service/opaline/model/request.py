@@ -103,7 +103,8 @@ class Job:
         data["material"] = self.material.model_dump(mode="json")
         data["quality"] = self.tier.name
         if self.tier.measured is not None:  # tier jobs keep the keys they had before auto
-            data["auto"] = {**self.tier.render_settings(), **asdict(self.tier.measured)}
+            data["auto"] = {**self.tier.render_settings(self.material),
+                            **asdict(self.tier.measured)}
         return data
 
     def cache_key(self, scene_key: str) -> str:
@@ -148,7 +149,7 @@ def resolve(request: RenderRequest | RenderFields, preset: Preset | None = None)
     material = Material(**{k: fields.pop(k) for k in MATERIAL_FIELDS if k in fields})
     quality = fields.pop("quality")
     tier = pick_for(preset.name, material, fields, **targets) if quality == "auto" else TIERS[quality]
-    for name, value in tier.render_settings().items():
+    for name, value in tier.render_settings(material).items():
         fields.setdefault(name, value)
     if fields["format"] == "auto":  # the HTTP service negotiates before resolving
         fields["format"] = "png"

@@ -12,7 +12,10 @@ and the values it ends up with.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
+
+if TYPE_CHECKING:
+    from opaline.model.material import Material
 
 TierName = Literal["draft", "standard", "high", "reference"]
 QualityName = Literal["draft", "standard", "high", "reference", "auto"]
@@ -34,7 +37,7 @@ class Measured:
 class Tier:
     name: QualityName
     samples: int
-    wavelengths: int
+    wavelengths: int  # the paper's rotation and the grating; a film's are below
     aa: AntiAliasName
     # K directional lights an environment becomes (bench/results/environment_lights.md,
     # 256², against K=256): each light costs about as much as the rest of the shading, and
@@ -55,15 +58,35 @@ class Tier:
     # piece costs about a tenth of the key light at 256², and standard's 3 keep the tier
     # inside 1.5× it, draft's 1 inside 3× the floor, where 2 were 2.8-2.9× (bench/speed_env.py).
     environment_samples_grating: int
+    # A thin film's wavelengths, per colour source's measured front: against an exact D65
+    # reference (bench/white_point.py, ΔE00 mean / worst), on a dielectric the RGB fast
+    # path (0) measured 0.10 / 1.5, 16 wavelengths 0.46 / 22 and 8 4.9 / 32 (thick films
+    # alias into false colours); on a metal the fast path 1.6 / 12, 16 wavelengths
+    # 0.37 / 7.0 and 8 3.2 / 35. Each tier takes the closest its cost allows.
+    film_wavelengths: int
+    metal_film_wavelengths: int
     measured: Measured | None = None  # quality=auto only
 
-    def render_settings(self) -> dict[str, int | str]:
-        """The fields a request may override one by one, as the tier sets them."""
-        return {"samples": self.samples, "wavelengths": self.wavelengths, "aa": self.aa}
+    def wavelengths_for(self, material: Material | None) -> int:
+        """The tier's wavelengths for ``material``'s colour source (the rotation's and the
+        grating's without one)."""
+        if material is None or material.iridescence != "thin-film":
+            return self.wavelengths
+        if material.substrate == "conductor":
+            return self.metal_film_wavelengths
+        return self.film_wavelengths
+
+    def render_settings(self, material: Material | None = None) -> dict[str, int | str]:
+        """The fields a request may override one by one, as the tier sets them for
+        ``material`` (its wavelengths depend on the colour source)."""
+        return {"samples": self.samples, "wavelengths": self.wavelengths_for(material),
+                "aa": self.aa}
 
     def describe(self) -> dict[str, int | str]:
         """The tier as GET /v1/tiers and ``--help`` show it."""
         return {"name": self.name, **self.render_settings(),
+                "film_wavelengths": self.film_wavelengths,
+                "metal_film_wavelengths": self.metal_film_wavelengths,
                 "environment_lights": self.environment_lights,
                 "environment_samples": self.environment_samples,
                 "environment_samples_rotation": self.environment_samples_rotation,
@@ -77,20 +100,20 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # little more than one RGB sample and has a third to half of its error.
     Tier("draft", samples=1, wavelengths=8, aa="analytic",
          environment_lights=8, environment_samples=2, environment_samples_rotation=3,
-         environment_samples_grating=1),
+         environment_samples_grating=1, film_wavelengths=0, metal_film_wavelengths=0),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
          environment_lights=16, environment_samples=6, environment_samples_rotation=9,
-         environment_samples_grating=3),
+         environment_samples_grating=3, film_wavelengths=0, metal_film_wavelengths=16),
     # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
     Tier("high", samples=8, wavelengths=16, aa="none",
          environment_lights=32, environment_samples=64, environment_samples_rotation=64,
-         environment_samples_grating=32),
+         environment_samples_grating=32, film_wavelengths=16, metal_film_wavelengths=16),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
     Tier("reference", samples=64, wavelengths=32, aa="none",
          environment_lights=64, environment_samples=1024, environment_samples_rotation=1024,
-         environment_samples_grating=512),
+         environment_samples_grating=512, film_wavelengths=32, metal_film_wavelengths=32),
 )}
 if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
     raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
@@ -112,4 +135,4 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
                 max(like.environment_samples, high.environment_samples),
                 max(like.environment_samples_rotation, high.environment_samples_rotation),
                 max(like.environment_samples_grating, high.environment_samples_grating),
-                measured)
+                wavelengths, wavelengths, measured)

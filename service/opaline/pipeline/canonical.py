@@ -61,7 +61,7 @@ def canonical_fields(job: Job, preset: Preset, request: RenderRequest | None = N
     if job.quality != preset_values["quality"]:
         fields["quality"] = job.quality
     # As resolve merges them: the tier's settings, unless the preset sets its own.
-    base = {**job.tier.render_settings(), **preset_values}
+    base = {**job.tier.render_settings(job.material), **preset_values}
     material = preset_material(preset)
     for field in JOB_FIELDS:
         if field in MATERIAL_FIELDS:

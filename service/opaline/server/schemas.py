@@ -53,7 +53,12 @@ class TierInfo(BaseModel):
 
     name: str
     samples: int = Field(description="Samples per pixel.")
-    wavelengths: int = Field(description="Wavelengths integrated (0: the paper's RGB model).")
+    wavelengths: int = Field(description="Wavelengths integrated (0: the paper's RGB model) "
+                                         "for the rotation and grating sources.")
+    film_wavelengths: int = Field(description="Wavelengths a thin film on a dielectric is "
+                                              "integrated at (0: the RGB fast path, closed "
+                                              "form over the colour weights).")
+    metal_film_wavelengths: int = Field(description="The same for a film on a conductor.")
     aa: str = Field(description="Anti-aliasing: 'analytic' or 'none'.")
     environment_lights: int = Field(description="Directional lights an environment becomes "
                                                 "where it is drawn as lights.")

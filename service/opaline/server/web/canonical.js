@@ -11,7 +11,7 @@
 // where the pick is the preset's tier.
 // tests/web/test_web_canonical.py checks the spelling against the service's.
 import { same } from './dom.js';
-import { state } from './state.js';
+import { state, tierSetting } from './state.js';
 
 // pipeline/canonical.py REQUEST_ONLY: the fields a job does not keep, right after the preset.
 export const REQUEST_ONLY = ['mesh', 'tangent_field', 'tangent_axis', 'max_flip', 'max_delta_e'];
@@ -51,9 +51,14 @@ const encode = (text) => encodeURIComponent(text)
 
 // What the job draws for `name` when the request leaves it out: the preset's value, or
 // for a tier setting the tier's (undefined under quality=auto: only the service knows).
-function baseOf(name, info, tier) {
+function baseOf(name, info, tier, fields) {
   if (name in info.resolved.material) return info.resolved.material[name];
-  if (TIER_SETTINGS.includes(name)) return name in info.defaults ? info.defaults[name] : tier?.[name];
+  if (TIER_SETTINGS.includes(name)) {
+    if (name in info.defaults) return info.defaults[name];
+    const material = { ...info.resolved.material };
+    for (const key of ['iridescence', 'substrate']) if (key in fields) material[key] = fields[key];
+    return tierSetting(name, tier, material);
+  }
   return info.resolved[name] ?? null;
 }
 
@@ -70,7 +75,7 @@ export function canonicalQuery(preset, fields, info = state.info) {
   const tier = state.tiers.get(quality);
   for (const name of state.order) {
     if (name === 'quality' || REQUEST_ONLY.includes(name) || !(name in fields)) continue;
-    if (!same(fields[name], baseOf(name, info, tier))) add(name, fields[name]);
+    if (!same(fields[name], baseOf(name, info, tier, fields))) add(name, fields[name]);
   }
   return parts.join('&');
 }

@@ -44,7 +44,17 @@ export function defaultOf(name) {
 export const valueOf = (name) => (name in state.overrides ? state.overrides[name] : defaultOf(name));
 
 // What the chosen quality tier sets for a tier field, when the tier is a named one.
-export const tierValue = (name) => state.tiers.get(valueOf('quality'))?.[name];
+// model/tiers.py Tier.wavelengths_for: a tier's wavelengths for the colour source drawn
+// (a film's are its own, on a dielectric or on a metal).
+export function tierSetting(name, tier, material) {
+  if (tier === undefined || name !== 'wavelengths' || material.iridescence !== 'thin-film') {
+    return tier?.[name];
+  }
+  return material.substrate === 'conductor' ? tier.metal_film_wavelengths : tier.film_wavelengths;
+}
+
+export const tierValue = (name) => tierSetting(name, state.tiers.get(valueOf('quality')),
+  { iridescence: valueOf('iridescence'), substrate: valueOf('substrate') });
 
 // The fields sent: the user's changes, in schema order.
 export function changedFields() {
