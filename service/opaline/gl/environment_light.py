@@ -21,8 +21,8 @@ from opaline.gl.uniforms import Uniforms
 from opaline.model import grating, visible
 from opaline.model.environment_light import band_samples, reads_orders, splits_lobe
 from opaline.model.params import Material
-from opaline.model.stack_film import is_stack
 from opaline.model.request import Job
+from opaline.model.stack_film import is_stack
 
 # From this many samples a pixel, the film is evaluated at each sample's own v·h, and the
 # rotation source's map samples take its spectral colour; below (draft's 2 and 3,
