@@ -5,10 +5,11 @@
 
 The target is the spectral path's weight density (visible.density_table: CIE 1931 under
 D65 to linear sRGB, each channel integrating to 1), per µm⁻¹ of wavenumber ν = 1000/λ;
-least squares (scipy) over 380-780 nm by 1 nm, from the current table as the start, then
-the L4 and L8 norms of the error, which approach its worst. Prints
-the table to paste, each channel's worst error as a share of its peak (the test holds it
-under 3 %: tests/model/test_physics_reference.py), and writes
+least squares (scipy) over 380-780 nm by 1 nm, then the L4, L8 and L16 norms of the error,
+which approach its worst; from the current table and, for a Gaussian it lacks, from each
+of several centres, keeping the best. Prints the table to paste, each channel's worst
+error as a share of its peak (the test holds it under 3 %:
+tests/model/test_physics_reference.py), and writes
 bench/results/fit_sensitivity.{json,md}.
 """
 

@@ -4,7 +4,7 @@ the tiers' wavelengths and the RGB fast path, in ΔE00.
     python bench/white_point.py [--thickness-step 10]
 
 Reference, independent of the project's code: colour-science's ``thin_film_tmm`` (s and p
-averaged) at every nm of 360-830, taken to XYZ under D65 by ``sd_to_XYZ`` (an sRGB white
+averaged) at every nm of 360-830, taken to XYZ under D65 by ``msds_to_XYZ`` (an sRGB white
 light: sRGB's white is D65), then to linear sRGB and CIELAB (D65) as colour-science does.
 Ours: ``thinfilm.film_rgb`` at 128 wavelengths (converged), 16 (standard), 8 (draft) and 0
 (the fast path), to CIELAB the same way. Negative channels (out of the sRGB gamut: the
