@@ -14,6 +14,9 @@ uniform int u_env_pass;
 uniform float u_env_total;
 uniform vec2 u_env_lobe_rotation[3];
 uniform vec3 u_env_sh[9];
+#ifdef COAT
+uniform float u_env_coat_total;
+#endif
 
 Environment environment_params() {
     Environment env;
@@ -26,6 +29,9 @@ Environment environment_params() {
     env.total = u_env_total;
     env.lobe_rotation = u_env_lobe_rotation;
     env.sh = u_env_sh;
+#ifdef COAT
+    env.coat_total = u_env_coat_total;
+#endif
     return env;
 }
 

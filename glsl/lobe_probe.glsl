@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS FILM_WEIGHT STACK_PAIRS
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS FILM_WEIGHT STACK_PAIRS COAT
 // Test harness for environment light: each pixel runs one case read from float
 // textures through lib/lobe_sampling.glsl and lib/environment_light.glsl, so the
 // samplers, the irradiance and the estimator can be held against their float64
@@ -6,7 +6,8 @@
 // 2 env_sample_half(a.xyz): (h, pdf); 3 environment_irradiance(a); 4 one pass of
 // environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1); 5 sample
 // k = a.x of env_sequence shifted by b; 6 specular_envelope at n = a toward v = c (the
-// ENV_ENVELOPE variant); 7 multipeak_band_cell at h = a.xy over a cell of side b.x.
+// ENV_ENVELOPE variant); 7 multipeak_band_cell at h = a.xy over a cell of side b.x;
+// 8 one pass of environment_coat in the frame (n = a, t = b) toward v = c (COAT).
 // Mode 0 needs the A-S variant (u_ex, u_ey), 7 the multi-peak one.
 #include "fullscreen.glsl"
 
@@ -47,6 +48,11 @@ void main() {
 #ifdef ENV_ENVELOPE
     if (u_mode == 6) {
         frag_color = vec4(specular_envelope(mat, env, a, c), 1.0);
+    }
+#endif
+#ifdef COAT
+    if (u_mode == 8) {
+        frag_color = vec4(environment_coat(mat, env, shading_frame(a, b), c), 1.0);
     }
 #endif
 #ifdef MDF_MULTIPEAK

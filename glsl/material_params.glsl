@@ -74,6 +74,11 @@ uniform float u_stack_spacer_ior;
 uniform float u_stack_spacer_nm;
 #endif
 #endif
+#ifdef COAT
+uniform float u_coat_weight;
+uniform float u_coat_f0;
+uniform float u_coat_exponent;
+#endif
 #ifdef IRIDESCENCE_GRATING
 uniform float u_grating_pitch_nm;
 uniform float u_grating_depth_nm;
@@ -132,6 +137,11 @@ Material material_params() {
 #if WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)
     mat.grating.channel_nm = u_channel_nm;
 #endif
+#endif
+#ifdef COAT
+    mat.coat.weight = u_coat_weight;
+    mat.coat.f0 = u_coat_f0;
+    mat.coat.exponent = u_coat_exponent;
 #endif
     return mat;
 }

@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS COAT
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -176,16 +176,6 @@ void main() {
     radiance += environment_irradiance(env, vec3(frame[2])) * mat.kd * mat.albedo / PI;
 #endif
 #endif
-#ifdef LIGHT_COUNT
-    for (int i = 0; i < LIGHT_COUNT; ++i) {
-        vec4 light = u_light_position[i];
-        vec3 to_light = light.xyz - light.w * v_world;
-        float dist2 = max(dot(to_light, to_light), 1e-8);
-        vec3 l = to_light * inversesqrt(dist2);
-        float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
-        radiance += u_light_irradiance[i] * falloff * reflected_radiance(mat, frame, l, v, film_nm);
-    }
-#endif
 #if defined(DIFFUSE) && !defined(ENVIRONMENT_MAP)
     radiance += u_ambient * mat.kd * mat.albedo;
 #endif
@@ -202,6 +192,24 @@ void main() {
     vec3 behind = u_backdrop;
 #endif
     radiance += behind * through * through;
+#endif
+#ifdef COAT
+    // What the coat lets through of all the above, and its own reflection of the map;
+    // the lights' reflectance below is layered the same way (lib/reflectance.glsl).
+    radiance *= coat_keep(mat.coat, float(dot(frame[2], real3(v))));
+#ifdef ENVIRONMENT_MAP
+    radiance += environment_coat(mat, env, frame, v);
+#endif
+#endif
+#ifdef LIGHT_COUNT
+    for (int i = 0; i < LIGHT_COUNT; ++i) {
+        vec4 light = u_light_position[i];
+        vec3 to_light = light.xyz - light.w * v_world;
+        float dist2 = max(dot(to_light, to_light), 1e-8);
+        vec3 l = to_light * inversesqrt(dist2);
+        float falloff = light.w > 0.5 ? 1.0 / dist2 : 1.0;
+        radiance += u_light_irradiance[i] * falloff * reflected_radiance(mat, frame, l, v, film_nm);
+    }
 #endif
 #ifdef DISPLAY
     frag_color = vec4(srgb_encode(tonemap(radiance * u_exposure)), 1.0);

@@ -101,9 +101,15 @@ def _extremes() -> dict[str, Material]:
         add(f"{mdf}:albedo=(1,0,0)", base, kd=1.0, albedo=(1.0, 0.0, 0.0))
         for label, value in {"0": 0.0, "1e-6": 1e-6, "0.5": 0.5, "1": 1.0}.items():
             add(f"{mdf}:f0={label}", base, f0=value)
+    # A clear coat over both MDFs, at the ends of its weight, roughness and index (issue 23).
+    for mdf, base in (("ashikhmin", ASHIKHMIN), ("multipeak", MULTIPEAK)):
+        add(f"{mdf}:coat=1,rough=0", base, coat_weight=1.0, coat_roughness=0.0)
+        add(f"{mdf}:coat=1,rough=1,ior=3", base, coat_weight=1.0, coat_roughness=1.0,
+            coat_ior=3.0)
+        add(f"{mdf}:coat=1e-6,ior=1", base, coat_weight=1e-6, coat_ior=1.0)
     # Everything at an end at once.
     add("ashikhmin:all-max", ASHIKHMIN, ex=1e6, ey=1e6, theta1=TWO_PI, theta2=-TWO_PI,
-        kd=100.0, ks=100.0, albedo=(1.0, 1.0, 1.0), f0=0.0)
+        kd=100.0, ks=100.0, albedo=(1.0, 1.0, 1.0), f0=0.0, coat_weight=1.0, coat_ior=3.0)
     add("ashikhmin:all-min", ASHIKHMIN, ex=0.0, ey=0.0, theta1=-TWO_PI, theta2=0.0,
         kd=0.0, ks=1e-6, albedo=(0.0, 0.0, 0.0), f0=0.0)
     add("multipeak:all-max", MULTIPEAK, mu_f=1000.0, alpha=1000.0, beta=1000.0, theta1=TWO_PI,

@@ -29,6 +29,9 @@ struct Environment {
     float total;  // the pixel's samples over all passes
     vec2 lobe_rotation[3];  // (cos, sin) of 0, theta1, theta2: the lobes sampled
     vec3 sh[9];  // irradiance coefficients, Â_l and Y_lm's constants folded in
+#ifdef COAT
+    float coat_total;  // the pixel's coat samples over all passes (lib/environment_coat.glsl)
+#endif
 };
 
 // Into the map's own frame (the environment turns, the object stays).
@@ -53,8 +56,8 @@ float env_texels_log2(Environment env, vec3 m, float solid_angle) {
     return 0.5 * log2(max(solid_angle, 1e-30) / texel);
 }
 
-// The level whose texel spans a lobe sample's share 1/(N·pdf).
-float env_lod(Environment env, vec3 m, float pdf_l) {
+// The level whose texel spans a lobe sample's share 1/(N·pdf), N = total.
+float env_lod_of(Environment env, vec3 m, float pdf_l, float total) {
 #ifdef ENV_BRUTE
     return 0.0;
 #else
@@ -62,9 +65,14 @@ float env_lod(Environment env, vec3 m, float pdf_l) {
     // samples; at the tiers' 2-64 a trilinear read of that level is wider than the lobe
     // itself. Measured against the brute-force reference (bench/environment_accuracy.py),
     // FLIP is least at -2 for every tier, map and lobe tried (docs/accuracy.md).
-    return clamp(env_texels_log2(env, m, 1.0 / max(env.total * pdf_l, 1e-30)) - 2.0,
+    return clamp(env_texels_log2(env, m, 1.0 / max(total * pdf_l, 1e-30)) - 2.0,
                  0.0, env.max_lod);
 #endif
+}
+
+// The same for the material's own lobe samples, env.total of them.
+float env_lod(Environment env, vec3 m, float pdf_l) {
+    return env_lod_of(env, m, pdf_l, env.total);
 }
 
 // The level whose texel spans a read's whole footprint (a grating's order); level 0 in
@@ -140,6 +148,9 @@ vec3 environment_irradiance(Environment env, vec3 n) {
 #include "lib/environment_lobes.glsl"
 #ifdef ENV_GRATING_ORDERS
 #include "lib/environment_grating.glsl"
+#endif
+#ifdef COAT
+#include "lib/environment_coat.glsl"
 #endif
 
 // A lobe sample's weight, f(l, v)·(n·l)/pdf(l); hl the sampled half vector and ll the

@@ -23,6 +23,9 @@
 #ifdef FRESNEL
 #include "lib/fresnel.glsl"
 #endif
+#ifdef COAT
+#include "lib/coat.glsl"
+#endif
 
 #ifdef IRIDESCENCE_THIN_FILM
 struct Film {  // lib/thin_film.glsl
@@ -71,6 +74,9 @@ struct Material {
 #endif
 #ifdef IRIDESCENCE_GRATING
     Grating grating;
+#endif
+#ifdef COAT
+    Coat coat;
 #endif
 };
 

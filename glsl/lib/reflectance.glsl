@@ -1,5 +1,6 @@
 // Ashikhmin-Shirley reflectance around the paper's MDF (docs/design.md §1.5):
 //   f_c = kd·albedo_c/π + ks·D_c(h)·F(v·h) / (4·(v·h)·max(n·l, n·v))
+// under a clear coat where one is compiled in (lib/coat.glsl),
 // returned already multiplied by max(n·l, 0), i.e. radiance per unit irradiance.
 #ifndef REFLECTANCE_GLSL
 #define REFLECTANCE_GLSL
@@ -57,6 +58,9 @@ vec3 reflected_radiance(Material mat, realmat3 frame, vec3 l, vec3 v, float film
     vec3 f = specular(mat, frame, l, v, film_nm);
 #ifdef DIFFUSE
     f += mat.kd * mat.albedo / PI;
+#endif
+#ifdef COAT
+    f = f * coat_keep(mat.coat, float(dot(frame[2], real3(v)))) + coat_specular(mat.coat, frame, l, v);
 #endif
     return f * max(float(dot(frame[2], real3(l))), 0.0);
 }

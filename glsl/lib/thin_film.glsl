@@ -13,7 +13,8 @@
 //                                                 with WAVELENGTHS = 0 (see film_rgb)
 //   vec2 u_substrate_nk[WAVELENGTHS, or 3 for R, G, B];  with SUBSTRATE_CONDUCTOR
 // With STACK_PAIRS the film is a stack of that many periods, each a layer of film.ior over
-// a spacer (lib/thin_film_stack.glsl). What the surface reflects is film_layer_rgb: the film over its base, by film.weight
+// a spacer (lib/thin_film_stack.glsl). What the surface reflects is film_layer_rgb: the
+// film over its base, by film.weight
 // (KHR iridescenceFactor) where FILM_WEIGHT is compiled in (a weight below 1), else the
 // film alone, as before the weight existed.
 #ifndef THIN_FILM_GLSL

@@ -19,7 +19,8 @@ from opaline.output import files
 
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere", "oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating",
-           "nacre-film", "anodised-titanium", "tempered-steel", "tempered-copper", "bragg-mirror")
+           "nacre-film", "anodised-titanium", "tempered-steel", "tempered-copper", "bragg-mirror",
+           "coated-paint")
 # docs/design.md §5 ranges (and exposure, light angles), written out independently of params.py.
 RANGES = {
     "ex": (0, 1e6), "ey": (0, 1e6), "mu_f": (0, 1000), "alpha": (0, 1000), "beta": (0, 1000),

@@ -168,6 +168,7 @@ CHANGED_MATERIAL = {
     "grating_orders": 2, "grating_depth": 120.0, "substrate": "conductor", "metal": "artist",
     "metal_f0": (0.9, 0.6, 0.3), "metal_edge_tint": (1.0, 0.9, 0.8), "film_weight": 0.5,
     "film_stack_pairs": 3, "film_spacer_ior": 1.2, "film_spacer_thickness": 90.0,
+    "coat_weight": 0.5, "coat_roughness": 0.2, "coat_ior": 1.6,
 }
 
 

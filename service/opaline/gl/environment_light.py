@@ -113,6 +113,9 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_rotation": rotation,
         "u_env_intensity": intensity,
         "u_env_total": float(per_pixel),
+        # A coat's samples (glsl/lib/environment_coat.glsl): one a pass, or the pass's
+        # lobe samples in the brute force.
+        "u_env_coat_total": float(per_pixel if brute else samples.passes * samples.factor ** 2),
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
     }

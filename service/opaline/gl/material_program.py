@@ -28,7 +28,7 @@ import numpy as np
 
 from opaline.gl import heightfield
 from opaline.gl.uniforms import Uniforms
-from opaline.model import grating, metals, stack_film, visible
+from opaline.model import coat, grating, metals, stack_film, visible
 from opaline.model.params import Material
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -84,6 +84,8 @@ def material_defines(material: Material, wavelengths: int = 0, aa: str = "none")
         defines["FILM_WEIGHT"] = True
     if stack_film.is_stack(material):
         defines["STACK_PAIRS"] = material.film_stack_pairs
+    if coat.has_coat(material):
+        defines["COAT"] = True
     return defines
 
 
@@ -137,6 +139,9 @@ def material_uniforms(material: Material, wavelengths: int = 0,
         "u_kd": material.kd,
         "u_albedo": tuple(material.albedo),
         "u_f0": material.f0,
+        "u_coat_weight": material.coat_weight,
+        "u_coat_f0": coat.coat_f0(material.coat_ior),
+        "u_coat_exponent": coat.exponent_from_roughness(material.coat_roughness),
     }
     if wavelengths > 0:
         values.update(spectral_uniforms(material, wavelengths, shift))

@@ -21,7 +21,7 @@ from opaline.model.params import Material
 
 # glsl/lobe_probe.glsl's modes: what each case evaluates.
 LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4,
-              "sequence": 5, "envelope": 6, "band_cell": 7}
+              "sequence": 5, "envelope": 6, "band_cell": 7, "coat": 8}
 
 
 
@@ -158,6 +158,8 @@ class Probes:
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,
                        "u_env_intensity": intensity, "u_env_total": float(samples * passes),
+                       # The coat's, one a pass (all of a pass's in the brute force).
+                       "u_env_coat_total": float((samples if brute else 1) * passes),
                        "u_env_lobe_rotation": environment_light.lobe_rotations(material)})
         if environment is not None:
             texture, sh = environment

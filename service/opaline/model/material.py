@@ -67,7 +67,7 @@ def about(group: str, unit: str | None = None, **applies: tuple[str, ...]) -> di
     return extra
 
 
-PHYSICAL, MATERIAL = "physical", "material"
+PHYSICAL, MATERIAL, COAT = "physical", "material", "coat"
 FILM, GRATING, ROTATION = ("thin-film",), ("grating",), ("rotation",)
 DIELECTRIC, CONDUCTOR, ARTIST = ("dielectric",), ("conductor",), ("artist",)
 
@@ -180,6 +180,19 @@ class Material(BaseModel):
     f0: Unit = Field(
         1.0, json_schema_extra=about(MATERIAL),
         description="Schlick reflectance at normal incidence, 0 … 1 (1 turns Fresnel off).")
+    coat_weight: Unit = Field(
+        0.0, json_schema_extra=about(COAT),
+        description="How much clear coat covers the material (KHR clearcoatFactor, OpenPBR "
+        "coat_weight), 0 … 1: the coat reflects weight·F_coat of the light in a lobe of its "
+        "own and dims what is below by as much; 0 is no coat.")
+    coat_roughness: Unit = Field(
+        0.0, json_schema_extra=about(COAT),
+        description="The coat's roughness as glTF means it (KHR clearcoatRoughnessFactor: "
+        "the GGX width is its square), 0 … 1; below 0.02 it is 0.02 (a mirror-sharp lobe).")
+    coat_ior: FilmIor = Field(
+        1.5, json_schema_extra=about(COAT),
+        description="The coat's refractive index (lacquer 1.5, KHR's fixed value; OpenPBR "
+        "coat_ior 1.6), 1 … 3: its Fresnel reflectance against air.")
 
 
 MATERIAL_FIELDS = tuple(Material.model_fields)

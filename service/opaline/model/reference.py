@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 # Re-exported (as X as X, for the type checker): the reference in one place.
+from opaline.model import coat
 from opaline.model.display import srgb_decode as srgb_decode
 from opaline.model.display import srgb_encode as srgb_encode
 from opaline.model.display import tonemap as tonemap
@@ -188,6 +189,7 @@ def reflected_radiance(
     nl = np.sum(frame[2] * l, axis=-1)
     diffuse = material.kd * np.asarray(material.albedo, dtype=np.float64) / np.pi
     f = diffuse + specular(material, frame, l, v, wavelengths)
+    f = coat.layered(material, frame, l, v, f)
     radiance: FloatArray = f * np.maximum(nl, 0.0)[..., None]
     return radiance
 

@@ -15,6 +15,7 @@ from opaline.model.tiers import TIERS
 GROUPS: list[tuple[str, str, tuple[str, ...]]] = [
     ("material", "Material", ()),
     ("physical", "Iridescence source", ()),
+    ("coat", "Clear coat", ()),
     ("light", "Light", ("light_azimuth", "light_elevation")),
     ("output", "Output", ("width", "height", "quality", "format", "exposure", "tonemap",
                           "transparent")),

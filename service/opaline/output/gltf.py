@@ -20,6 +20,7 @@ import numpy as np
 import pygltflib as gl
 
 from opaline import __version__
+from opaline.model.coat import roughness_from_exponent
 from opaline.model.meshes import is_mesh
 from opaline.model.params import MATERIAL_FIELDS, Material
 from opaline.model.presets import Preset, build_assets, build_thickness
@@ -29,7 +30,6 @@ from opaline.output.gltf_iridescence import (
     base_colour_and_metallic,
     field_png,
     is_thin_film,
-    roughness_from_exponent,
     thin_film_extensions,
     thin_film_fields,
 )

@@ -36,6 +36,7 @@ from PIL import Image
 from pydantic import ValidationError
 
 from opaline.model import metals
+from opaline.model.coat import exponent_from_roughness
 from opaline.model.params import Material, MaterialFields
 from opaline.model.spectrum import rgb_weights
 from opaline.scene.gltf_film import IRIDESCENCE
@@ -104,24 +105,6 @@ def _number(block: dict[str, Any], key: str, default: float) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ValueError(f"{key} must be a number, not {value!r}")
     return float(value)
-
-
-# glTF's roughness r is perceptual: the GGX width is α = r² (glTF 2.0 spec, appendix B),
-# and the A-S (Blinn-Phong) exponent of the same width is n = 2/α² - 2 (Walter et al.
-# 2007, §5.2), so n = 2/r⁴ - 2; roughness 0.1 is n ≈ 20 000, not the 198 of r read as α.
-EXPONENT_MAX = 1e6  # Material's range
-
-
-def exponent_from_roughness(roughness: float) -> float:
-    """The A-S exponent of a glTF roughness (clamped to [0.02, 1] as importers do)."""
-    alpha = float(np.clip(roughness, 0.02, 1.0)) ** 2
-    return float(min(2.0 / alpha**2 - 2.0, EXPONENT_MAX))
-
-
-def roughness_from_exponent(exponent: float) -> float:
-    """glTF roughness of an A-S exponent: the inverse of ``exponent_from_roughness``."""
-    alpha = np.sqrt(2.0 / (max(exponent, 0.0) + 2.0))
-    return float(np.clip(np.sqrt(alpha), 0.02, 1.0))
 
 
 def thin_film_fields(material: gl.Material) -> dict[str, Any]:

@@ -52,6 +52,7 @@ CHECK_S_PER_BYTE = 0.15 / (1 << 20)
 # holds at least 12 bytes a triangle (uint32 indices of shared vertices).
 TRIANGLE_PASS_S = 0.25e-6
 MIN_BYTES_PER_TRIANGLE = 12
+COAT_COST = 1.3  # shading_index
 GROWTH_W = 208.0  # growth(W) = (1 + W/208) / (1 + W_calibrated/208): ×1.5 at 128 from 16
 
 
@@ -137,16 +138,19 @@ class CostModel:
                                for k, c in self.labels.items()}}
 
 
-def shading_index(iridescence: str, orders: int, stack_pairs: int = 0) -> float:
+def shading_index(iridescence: str, orders: int, stack_pairs: int = 0,
+                  coated: bool = False) -> float:
     """Shading cost per pixel-sample-wavelength over the paper's rotations', measured on
     llvmpipe at 0, 16 and 128 wavelengths: a thin film 0.5-1.8× (dearest without
     wavelengths, where it is cheap), a grating of m orders 2.3-3.3× (m = 1), 4.1-5.4× (3),
     6.6-10× (8); the safety factor covers the spread. A stack of N pairs, over the single
     film (oil-film, draft, one sample, at 0, 16 and 64 wavelengths): 1.4-1.8× (N = 1),
-    2.2-3.8× (4), 8.8-15.6× (16), inside 1 + N."""
+    2.2-3.8× (4), 8.8-15.6× (16), inside 1 + N. A clear coat, over the same material
+    uncoated (256², draft and standard, the key light and the studio): 0.96-1.29×."""
+    coat = COAT_COST if coated else 1.0
     if iridescence == "grating":
-        return 2.0 + orders
-    return 1.25 * (1 + stack_pairs) if iridescence == "thin-film" else 1.0
+        return coat * (2.0 + orders)
+    return coat * (1.25 * (1 + stack_pairs) if iridescence == "thin-film" else 1.0)
 
 
 def mesh_cost_s(size_bytes: int, max_triangles: int, passes: int) -> float:

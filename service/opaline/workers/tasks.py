@@ -71,6 +71,7 @@ class ImageTask:
         material = tuple(sorted((k, v) for k, v in job.material.model_dump().items()
                                 if isinstance(v, (str, bool))
                                 or k in ("grating_orders", "film_stack_pairs")))
+        material += (("coat", job.material.coat_weight > 0.0),)  # COAT's define
         return (self.prepared.preset.name, self.prepared.preset.geometry.args.get("path"),
                 job.wavelengths, job.samples, job.aa, job.tonemap, job.transparent,
                 job.environment, job.environment_lights, job.environment_samples,
@@ -86,10 +87,11 @@ class ImageTask:
         own = preset_fields(preset)
         material = job.material
         units *= max(1.0, shading_index(material.iridescence, material.grating_orders,
-                                        material.film_stack_pairs)
+                                        material.film_stack_pairs, material.coat_weight > 0.0)
                      / shading_index(own.get("iridescence") or "rotation",
                                      own.get("grating_orders") or 3,
-                                     own.get("film_stack_pairs") or 0))
+                                     own.get("film_stack_pairs") or 0,
+                                     (own.get("coat_weight") or 0.0) > 0.0))
         return preset.name, units, job.wavelengths, self._mesh_s()
 
     def _mesh_s(self) -> float:
