@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS COAT
+//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS COAT FILM_WEIGHT_MAP
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -84,6 +84,9 @@ uniform float u_lod_bias;
 #if defined(IRIDESCENCE_THIN_FILM) && defined(THICKNESS_MAP)
 uniform sampler2D u_thickness_map;  // [0, 1] → [min, max] nm, as KHR's thickness texture
 #endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(FILM_WEIGHT_MAP)
+uniform sampler2D u_weight_map;  // [0, 1], times film_weight: KHR's iridescenceTexture
+#endif
 #ifdef WAVES
 #include "lib/waves.glsl"
 uniform mat3 u_normal_matrix;
@@ -164,6 +167,13 @@ void main() {
                         texture(u_thickness_map, v_uv).r);
 #else
     float film_nm = -1.0;  // the material's maximum (thin film), else not read
+#endif
+#if defined(IRIDESCENCE_THIN_FILM) && defined(FILM_WEIGHT_MAP) && defined(OBJECT_PROJECTION)
+    mat.film.weight *= w.x * texture(u_weight_map, triplanar_uv_x(q)).r
+                       + w.y * texture(u_weight_map, triplanar_uv_y(q)).r
+                       + w.z * texture(u_weight_map, triplanar_uv_z(q)).r;
+#elif defined(IRIDESCENCE_THIN_FILM) && defined(FILM_WEIGHT_MAP)
+    mat.film.weight *= texture(u_weight_map, v_uv).r;
 #endif
     vec3 v = normalize(u_eye - v_world);
 

@@ -174,9 +174,9 @@ def test_a_bomb_or_a_16_bit_texture(tmp_path):
 
 
 def test_the_json_chunk_alone_says_whether_a_file_has_a_film(tmp_path):
-    from opaline.scene.gltf_film import has_thickness_texture, texture_names
+    from opaline.scene.gltf_film import film_texture_names, texture_names
 
     path = tmp_path / "film.glb"
     path.write_bytes(other_tools_glb())
-    assert has_thickness_texture(path)
+    assert film_texture_names(path) == {"iridescenceThicknessTexture", "iridescenceTexture"}
     assert texture_names(b"glTF" + bytes(8) + b"\xff\xff\xff\x7fJSON" + b"[" * 100000) == set()

@@ -17,7 +17,7 @@ from opaline.gl import physical
 from opaline.gl.culling import Culling
 from opaline.model import projection
 from opaline.model.meshes import is_mesh
-from opaline.model.presets import Preset, build_assets, build_thickness
+from opaline.model.presets import Preset, build_assets, build_thickness, build_weight
 
 # Three RGBA float32 textures (sample, accumulation, float display), an RGBA8 display
 # texture and a 32-bit depth buffer.
@@ -138,11 +138,12 @@ class SceneGPU:
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             self.normal_map.repeat_x = self.normal_map.repeat_y = True
         self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset))
+        self.weight_map = physical.thickness_texture(ctx, build_weight(preset))
         self.culling = Culling(mesh.positions, mesh.indices)
         # Mipmaps add a third to a texture.
         self.nbytes = self.vbo.size + self.ibo.size + sum(
             tex.width * tex.height * tex.components * 4 * 4 // 3
-            for tex in (self.normal_map, self.thickness_map) if tex is not None)
+            for tex in (self.normal_map, self.thickness_map, self.weight_map) if tex is not None)
         self._vaos: dict[int, moderngl.VertexArray] = {}
 
     def vao(self, ctx: moderngl.Context, program: moderngl.Program) -> moderngl.VertexArray:
@@ -162,6 +163,6 @@ class SceneGPU:
     def release(self) -> None:
         for vao in self._vaos.values():
             vao.release()
-        for obj in (self.vbo, self.ibo, self.normal_map, self.thickness_map):
+        for obj in (self.vbo, self.ibo, self.normal_map, self.thickness_map, self.weight_map):
             if obj is not None:
                 obj.release()

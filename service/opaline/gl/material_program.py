@@ -103,6 +103,10 @@ def uses_thickness_map(material: Material, preset: Preset) -> bool:
     return material.iridescence == "thin-film" and preset.thickness_map is not None
 
 
+def uses_weight_map(material: Material, preset: Preset) -> bool:
+    return material.iridescence == "thin-film" and preset.weight_map is not None
+
+
 def uses_transmission(material: Material, preset: Preset) -> bool:
     # A metal under the film lets nothing through.
     return material.iridescence == "thin-film" and preset.transmission and not is_conductor(material)
@@ -117,6 +121,8 @@ def surface_defines(job: Job, preset: Preset) -> Defines:
     defines.update(heightfield.defines(preset))
     if uses_thickness_map(job.material, preset):
         defines["THICKNESS_MAP"] = True
+    if uses_weight_map(job.material, preset):  # the weight per texel, times film_weight
+        defines["FILM_WEIGHT_MAP"] = defines["FILM_WEIGHT"] = True
     if uses_transmission(job.material, preset):
         defines["TRANSMISSION"] = True
     return defines

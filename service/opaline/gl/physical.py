@@ -11,7 +11,8 @@ import numpy as np
 
 def thickness_texture(ctx: moderngl.Context,
                       field: np.ndarray | None) -> moderngl.Texture | None:
-    """A thickness field as a tiling, mipmapped one-channel float texture."""
+    """A [0, 1] field over uv (a film's thickness or weight) as a tiling, mipmapped
+    one-channel float texture."""
     if field is None:
         return None
     height, width = field.shape

@@ -163,6 +163,10 @@ class SurfacePass:
             values["u_thickness_map"] = texture_units.THICKNESS_MAP
             assert scene.thickness_map is not None  # the define follows the preset's map
             scene.thickness_map.use(location=texture_units.THICKNESS_MAP)
+        if defines.get("FILM_WEIGHT_MAP"):
+            values["u_weight_map"] = texture_units.WEIGHT_MAP
+            assert scene.weight_map is not None  # the define follows the preset's map
+            scene.weight_map.use(location=texture_units.WEIGHT_MAP)
         return values
 
     def _samples(self, job: Job, preset: Preset, targets: Targets, plan: DrawPlan,

@@ -11,7 +11,7 @@ from typing import Any
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
 from opaline.scene.environments import MESH_ENVIRONMENT
-from opaline.scene.gltf_film import has_thickness_texture
+from opaline.scene.gltf_film import film_texture_names
 
 MESH_KIND = "file"
 # The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
@@ -32,7 +32,8 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
     ``MESH_ENVIRONMENT`` unless the preset names an environment, the camera framed on the
     mesh by the renderer (the maps projected in object space where the mesh has no UVs, or
     where the preset asks: ``opaline.model.projection``). A .glb carrying a KHR thickness
-    texture draws its film with it instead of the preset's field."""
+    texture draws its film with it instead of the preset's field, and one with a factor
+    texture weighs its film by it texel by texel."""
     # The generator's arguments (scene.meshfile.mesh_file's), of their several types.
     args: dict[str, Any] = {"kind": MESH_KIND, "path": str(path), "digest": digest,
                             "tangent_field": request.tangent_field or _default_field(base),
@@ -43,9 +44,12 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
     update: dict[str, Any] = {"name": f"mesh-{digest[:12]}", "geometry": Generator(**args),
                               "defaults": defaults, "tangents": "uv",
                               "rotation_deg": (0.0, 0.0, 0.0)}
-    if has_thickness_texture(path):  # a .glb's own film, in its own UVs
-        film: dict[str, Any] = {"kind": "glb", "path": str(path), "digest": digest}
-        update.update(thickness_map=Generator(**film), mesh_projection="auto")
+    names = film_texture_names(path)
+    film: dict[str, Any] = {"path": str(path), "digest": digest}
+    if "iridescenceThicknessTexture" in names:  # a .glb's own film, in its own UVs
+        update.update(thickness_map=Generator(kind="glb", **film), mesh_projection="auto")
+    if "iridescenceTexture" in names:  # and its weight per texel
+        update.update(weight_map=Generator(kind="glb-factor", **film), mesh_projection="auto")
     return base.model_copy(update=update)
 
 

@@ -74,6 +74,8 @@ class Preset(BaseModel):
     normal_map: Generator | None = None
     # Film thickness in [0, 1] over uv, mapped to [film_thickness_min, max] (thin film only).
     thickness_map: Generator | None = None
+    # The film's weight in [0, 1] over uv, times film_weight (a .glb's KHR iridescenceTexture).
+    weight_map: Generator | None = None
     # How a user's mesh takes the maps: its UVs where it has them ("auto"), or always by
     # object-space projection ("object": maps whose look is their scale, such as nacre).
     mesh_projection: MeshProjection = "auto"
@@ -92,6 +94,8 @@ class Preset(BaseModel):
         if self.geometry.kind != "file":
             # It shapes only a user's mesh: the presets' own scenes keep their keys.
             del scene["mesh_projection"]
+        if self.weight_map is None:  # keys from before the weight map stay what they were
+            del scene["weight_map"]
         return hashlib.sha256(json.dumps(scene, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -114,6 +118,7 @@ def _check_generators(filename: str, preset: Preset) -> None:
     try:
         build_assets(preset)
         build_thickness(preset)
+        build_weight(preset)
     except ValueError as exc:
         raise PresetError(f"preset {filename}: {exc}") from exc
 
@@ -155,18 +160,27 @@ def _normal_map(generator: Generator | None) -> Any:
     return _normal_maps[key]
 
 
-_thickness: dict[str, Any] = {}
+_film_fields: dict[tuple[str, str], Any] = {}
+
+
+def _film_field(preset: Preset, which: str, generator: Generator | None) -> Any:
+    key = (preset.scene_key(), which)
+    if key not in _film_fields:
+        field = None
+        if generator is not None:
+            field = thickness.build(generator.kind, **_map_args(generator))
+        _film_fields[key] = field
+    return _film_fields[key]
 
 
 def build_thickness(preset: Preset) -> Any:
     """The preset's film-thickness field (or None), generated once per scene."""
-    key = preset.scene_key()
-    if key not in _thickness:
-        field = None
-        if preset.thickness_map is not None:
-            field = thickness.build(preset.thickness_map.kind, **_map_args(preset.thickness_map))
-        _thickness[key] = field
-    return _thickness[key]
+    return _film_field(preset, "thickness", preset.thickness_map)
+
+
+def build_weight(preset: Preset) -> Any:
+    """The preset's film-weight field (or None), generated once per scene."""
+    return _film_field(preset, "weight", preset.weight_map)
 
 
 @cache

@@ -20,9 +20,8 @@ no film, is refused: that is a plain material), with the extension's defaults (i
 1.3, thickness 100-400 nm) where a key is absent and the glTF base ior 1.5 without
 KHR_materials_ior. The imported material file draws the .glb itself as its mesh, and a
 .glb with a thickness texture draws its film with it, in its own UVs
-(scene.gltf_film). The weight is one number per material in the shader: an
-iridescenceTexture (KHR's per-texel factor, R) is carried through to the export but
-not drawn; iridescenceFactor alone gives film_weight.
+(scene.gltf_film), and one with an iridescenceTexture (KHR's per-texel factor, R)
+weighs its film by it texel by texel, times film_weight; both go back to the export.
 """
 
 from __future__ import annotations

@@ -5,7 +5,8 @@ float32 field stored as Opaline stores its own, row 0 at glTF's t = 0, which is 
 
 A user's .glb that carries a thickness texture draws its film with it (a ``glb``
 thickness field, ``scene.thickness``), in the mesh's own UVs, in place of its preset's;
-the export writes both textures back (``output.gltf``). Every image is checked before
+one that carries a factor texture weighs its film by it (a ``glb-factor`` field, the
+preset's ``weight_map``); the export writes both textures back (``output.gltf``). Every image is checked before
 it is decoded: at most ``MAX_TEXELS`` texels, PNG or JPEG, in the file's binary chunk.
 """
 
@@ -134,15 +135,15 @@ def texture_names(head: bytes) -> set[str]:
     return set(CHANNELS) & set(film) if isinstance(film, dict) else set()
 
 
-def has_thickness_texture(path: Path) -> bool:
-    """Whether a mesh file is a .glb whose film names a thickness texture: its JSON chunk
+def film_texture_names(path: Path) -> set[str]:
+    """The KHR textures a mesh file's film names (none where it is no .glb): its JSON chunk
     alone is read (a request's scene is prepared from it; the mesh loader decodes and
-    checks the image, ``check_film_textures``)."""
+    checks the images, ``check_film_textures``)."""
     with open(path, "rb") as stream:
         head = stream.read(20)
         if len(head) == 20 and head[:4] == b"glTF":
             head += stream.read(struct.unpack("<I", head[12:16])[0])
-    return "iridescenceThicknessTexture" in texture_names(head)
+    return texture_names(head)
 
 
 def check_film_textures(data: bytes) -> None:

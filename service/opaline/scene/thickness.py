@@ -10,6 +10,8 @@ top, v = 1), like the normal maps; the upload flips rows.
 - ``platelets``: Voronoi cells, each its own thickness (nacre's aragonite tablets).
 - ``file``: a greyscale image next to the preset.
 - ``glb``: a user's .glb's own KHR thickness texture (``scene.gltf_film``).
+- ``glb-factor``: its factor texture (KHR iridescenceTexture): the film's weight, not a
+  thickness (a preset's ``weight_map``).
 """
 
 from __future__ import annotations
@@ -123,8 +125,7 @@ def _file(path: str | os.PathLike[str]) -> np.ndarray:
     return field
 
 
-def _glb(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
-    """The thickness texture of a user's .glb (``digest``: the file's, for the scene key)."""
+def _glb_texture(path: str | os.PathLike[str], key: str) -> np.ndarray:
     from opaline.scene.gltf_film import IRIDESCENCE, read_film_textures
 
     try:
@@ -132,10 +133,20 @@ def _glb(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
             data = stream.read()
     except OSError as error:
         raise ValueError(f"argument 'path': cannot read {str(path)!r}: {error}") from None
-    field = read_film_textures(data, ("iridescenceThicknessTexture",)).thickness
+    field = read_film_textures(data, (key,)).by_key().get(key)
     if field is None:
-        raise ValueError(f"argument 'path': {str(path)!r} has no {IRIDESCENCE} thickness texture")
+        raise ValueError(f"argument 'path': {str(path)!r} has no {IRIDESCENCE} {key}")
     return field
+
+
+def _glb(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
+    """The thickness texture of a user's .glb (``digest``: the file's, for the scene key)."""
+    return _glb_texture(path, "iridescenceThicknessTexture")
+
+
+def _glb_factor(path: str | os.PathLike[str], digest: str = "") -> np.ndarray:
+    """The factor texture of a user's .glb: the film's weight per texel, times film_weight."""
+    return _glb_texture(path, "iridescenceTexture")
 
 
 KINDS: dict[str, Callable[..., np.ndarray]] = {
@@ -144,6 +155,7 @@ KINDS: dict[str, Callable[..., np.ndarray]] = {
     "platelets": platelets,
     "file": _file,
     "glb": _glb,
+    "glb-factor": _glb_factor,
 }
 
 
