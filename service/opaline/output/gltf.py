@@ -24,8 +24,8 @@ from opaline.model.coat import roughness_from_exponent
 from opaline.model.meshes import is_mesh
 from opaline.model.params import MATERIAL_FIELDS, Material
 from opaline.model.presets import Preset, build_assets, build_thickness
+from opaline.output.gltf_coat import coat_extensions
 from opaline.output.gltf_iridescence import (
-    IOR,
     add_film_texture,
     base_colour_and_metallic,
     field_png,
@@ -109,10 +109,13 @@ def export_glb(mesh: Mesh, material: Material, wavelengths: int = 0, name: str =
         scene=0, scenes=[gl.Scene(nodes=[0])], nodes=[gl.Node(mesh=0, name=name)],
         meshes=[gl.Mesh(name=name, primitives=[primitive])], materials=[gltf_material],
         accessors=accessors, bufferViews=views, buffers=[gl.Buffer(byteLength=len(blob))])
+    extensions = coat_extensions(material)
     if film:
         indices = {key: add_film_texture(document, view) for key, view in image_views.items()}
-        gltf_material.extensions = thin_film_extensions(material, indices)
-        document.extensionsUsed = [IRIDESCENCE, IOR]
+        extensions.update(thin_film_extensions(material, indices))
+    if extensions:
+        gltf_material.extensions = extensions
+        document.extensionsUsed = sorted(extensions)
     document.set_binary_blob(blob)
     return b"".join(document.save_to_bytes())
 

@@ -38,6 +38,7 @@ from opaline.model import metals
 from opaline.model.coat import exponent_from_roughness
 from opaline.model.params import Material, MaterialFields
 from opaline.model.spectrum import rgb_weights
+from opaline.output.gltf_coat import coat_fields
 from opaline.scene.gltf_film import IRIDESCENCE
 
 IOR = "KHR_materials_ior"
@@ -137,6 +138,7 @@ def thin_film_fields(material: gl.Material) -> dict[str, Any]:
     if metallic >= 1.0:  # a film on a metal: its base colour is the metal's F0
         fields.update(substrate="conductor", metal="artist", kd=0.0,
                       metal_f0=fields["albedo"], metal_edge_tint=[1.0, 1.0, 1.0])
+    fields.update(coat_fields(extensions))
     try:
         MaterialFields.model_validate(fields)
     except ValidationError as exc:
