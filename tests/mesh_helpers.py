@@ -76,3 +76,29 @@ def assert_framed(alpha: np.ndarray) -> None:
     assert top > 0 and left > 0 and bottom < h - 1 and right < w - 1, (top, bottom, left, right)
     assert (bottom - top + 1) * (right - left + 1) > 0.15 * h * w
     assert max(bottom - top + 1, right - left + 1) > 0.6 * min(h, w)
+
+
+def glb_with_film(document, images: dict[str, bytes], film: dict) -> bytes:
+    """``document`` (a pygltflib GLTF2 with a binary blob) with ``images`` (PNG bytes, by
+    the KHR texture key each becomes) appended and its first material's film set to
+    ``film`` and those textures, as another tool writes it: no Opaline extras."""
+    import pygltflib
+
+    blob = document.binary_blob()
+    film = dict(film)
+    for key, raw in images.items():
+        blob += b"\0" * (-len(blob) % 4)
+        document.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=len(blob),
+                                                         byteLength=len(raw)))
+        blob += raw
+        document.images.append(pygltflib.Image(bufferView=len(document.bufferViews) - 1,
+                                               mimeType="image/png"))
+        document.textures.append(pygltflib.Texture(source=len(document.images) - 1))
+        film[key] = {"index": len(document.textures) - 1}
+    material = document.materials[0]
+    material.extras = {}
+    material.extensions = {"KHR_materials_iridescence": film}
+    document.extensionsUsed = ["KHR_materials_iridescence"]
+    document.buffers[0].byteLength = len(blob)
+    document.set_binary_blob(blob)
+    return b"".join(document.save_to_bytes())

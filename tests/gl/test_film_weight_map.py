@@ -13,6 +13,7 @@ import pygltflib
 import pytest
 from PIL import Image
 
+from mesh_helpers import glb_with_film
 from opaline.local.context import local_context
 from opaline.local.export import export_material
 from opaline.model.params import RenderRequest
@@ -20,7 +21,6 @@ from opaline.pipeline.prepare import prepare
 
 pytestmark = pytest.mark.gl
 
-KHR = "KHR_materials_iridescence"
 FILM = {"iridescence": "thin-film", "film_ior": 1.4, "film_thickness_min": 500.0,
         "film_thickness_max": 500.0, "substrate_ior": 2.4, "mdf": "ashikhmin", "ex": 20.0,
         "ey": 20.0, "kd": 0.0, "ks": 1.0, "theta1": 0.0, "theta2": 0.0, "environment": "none"}
@@ -29,24 +29,10 @@ FILM = {"iridescence": "thin-film", "film_ior": 1.4, "film_thickness_min": 500.0
 def with_factor(factor: np.ndarray) -> bytes:
     """The sphere as a .glb whose film has ``factor`` (uint8) as its iridescenceTexture."""
     document = pygltflib.GLTF2.load_from_bytes(export_material({"preset": "sphere"}, "glb"))
-    blob = document.binary_blob()
     out = io.BytesIO()
     Image.fromarray(np.stack([factor, 255 - factor, factor], axis=-1), "RGB").save(out, "PNG")
-    raw = out.getvalue()
-    blob += b"\0" * (-len(blob) % 4)
-    document.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=len(blob),
-                                                     byteLength=len(raw)))
-    blob += raw
-    document.images.append(pygltflib.Image(bufferView=len(document.bufferViews) - 1,
-                                           mimeType="image/png"))
-    document.textures.append(pygltflib.Texture(source=len(document.images) - 1))
-    document.materials[0].extras = {}
-    document.materials[0].extensions = {KHR: {"iridescenceFactor": 1.0, "iridescenceTexture": {
-        "index": len(document.textures) - 1}}}
-    document.extensionsUsed = [KHR]
-    document.buffers[0].byteLength = len(blob)
-    document.set_binary_blob(blob)
-    return b"".join(document.save_to_bytes())
+    return glb_with_film(document, {"iridescenceTexture": out.getvalue()},
+                         {"iridescenceFactor": 1.0})
 
 
 def draw(renderer, path, **fields) -> np.ndarray:

@@ -12,6 +12,7 @@ import pygltflib
 import pytest
 from PIL import Image
 
+from mesh_helpers import glb_with_film
 from opaline.local.context import local_context
 from opaline.local.export import export_material, import_material
 from opaline.model.params import Material, RenderRequest
@@ -40,27 +41,11 @@ def other_tools_glb(thickness_png: bytes | None = None) -> bytes:
     """The sphere (it has UVs) as a .glb with a film of factor 0.5 and both textures."""
     mesh, _ = build_assets(get_preset("sphere"))
     document = pygltflib.GLTF2.load_from_bytes(export_glb(mesh, Material()))
-    blob = document.binary_blob()
     images = {"iridescenceThicknessTexture": thickness_png or png(THICKNESS, 1),
               "iridescenceTexture": png(FACTOR, 0)}
     film = {"iridescenceFactor": 0.5, "iridescenceIor": 1.4,
             "iridescenceThicknessMinimum": 200.0, "iridescenceThicknessMaximum": 800.0}
-    for key, raw in images.items():
-        blob += b"\0" * (-len(blob) % 4)
-        document.bufferViews.append(pygltflib.BufferView(buffer=0, byteOffset=len(blob),
-                                                         byteLength=len(raw)))
-        blob += raw
-        document.images.append(pygltflib.Image(bufferView=len(document.bufferViews) - 1,
-                                               mimeType="image/png"))
-        document.textures.append(pygltflib.Texture(source=len(document.images) - 1))
-        film[key] = {"index": len(document.textures) - 1}
-    material = document.materials[0]
-    material.extras = {}  # another tool: no Opaline parameters, the extension alone
-    material.extensions = {KHR: film}
-    document.extensionsUsed = [KHR]
-    document.buffers[0].byteLength = len(blob)
-    document.set_binary_blob(blob)
-    return b"".join(document.save_to_bytes())
+    return glb_with_film(document, images, film)
 
 
 def test_imports_draws_and_exports_the_factor_and_both_textures(tmp_path):
