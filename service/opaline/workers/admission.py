@@ -146,7 +146,8 @@ def shading_index(iridescence: str, orders: int, stack_pairs: int = 0,
     6.6-10× (8); the safety factor covers the spread. A stack of N pairs, over the single
     film (oil-film, draft, one sample, at 0, 16 and 64 wavelengths): 1.4-1.8× (N = 1),
     2.2-3.8× (4), 8.8-15.6× (16), inside 1 + N. A clear coat, over the same material
-    uncoated (256², draft and standard, the key light and the studio): 0.96-1.29×."""
+    uncoated (256², draft and standard, the key light and the studio): 0.87-1.29×
+    over two runs (bench/coat_cost.py)."""
     coat = COAT_COST if coated else 1.0
     if iridescence == "grating":
         return coat * (2.0 + orders)
