@@ -65,19 +65,26 @@ def metal_reflectance(n_film: float, metal: str, thickness: np.ndarray) -> np.nd
     return optics.reflectance
 
 
+def reference_xyz(reflectance: np.ndarray) -> np.ndarray:
+    """(…, 3) XYZ (a white's Y = 1) of a reflectance (λ, …) lit by D65, by colour-science."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    d65 = colour.SDS_ILLUMINANTS["D65"]
+    shape = colour.SpectralShape(360.0, 830.0, 1.0)
+    data = reflectance.reshape(len(REFERENCE_NM), -1)
+    msds = colour.MultiSpectralDistributions(data, shape)
+    xyz = colour.msds_to_XYZ(msds, cmfs, d65, method="Integration", shape=shape) / 100.0
+    return np.asarray(xyz).reshape(*reflectance.shape[1:], 3)
+
+
 def reference_rgb(reflectance: np.ndarray) -> np.ndarray:
     """(angle, thickness, 3) linear sRGB of a reflectance (λ, angle, thickness) lit by D65,
     by colour-science."""
     import colour
 
-    lam = REFERENCE_NM
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
-    d65 = colour.SDS_ILLUMINANTS["D65"]
-    shape = colour.SpectralShape(360.0, 830.0, 1.0)
-    data = reflectance.reshape(len(lam), -1)
-    msds = colour.MultiSpectralDistributions(data, shape)
-    xyz = colour.msds_to_XYZ(msds, cmfs, d65, method="Integration", shape=shape) / 100.0
-    rgb = colour.XYZ_to_RGB(xyz, colour.RGB_COLOURSPACES["sRGB"], apply_cctf_encoding=False)
+    rgb = colour.XYZ_to_RGB(reference_xyz(reflectance), colour.RGB_COLOURSPACES["sRGB"],
+                            apply_cctf_encoding=False)
     return np.asarray(rgb).reshape(*reflectance.shape[1:], 3)
 
 
