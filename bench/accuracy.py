@@ -2,6 +2,8 @@
 
     python bench/accuracy.py [--size 128] [--presets cd-rom ...] [--write-table]
     python bench/accuracy.py --from-results [--write-table]   # tables and plot again
+    python bench/accuracy.py --presets morpho --merge [--write-table]   # one preset again
+    python bench/accuracy.py --from-results --time-tiers [--presets oil-film ...]
 
 Per preset, a grid over samples × wavelengths × anti-aliasing (accuracy_grid.py),
 each point timed (fastest of 3 warm renders) and scored against the converged
@@ -13,6 +15,9 @@ bench/results/references/; the raw rows go to bench/results/accuracy_grid.json.
 Writes docs/accuracy.md (accuracy_report.py; the hand-written GUIDE section is
 kept), docs/accuracy.csv, docs/accuracy.png (accuracy_plot.py), and with
 --write-table the table quality=auto reads, service/opaline/model/quality_table.json.
+--merge measures only the named presets and keeps every other preset's rows from the last
+run: valid only while the shaders are the ones that run measured (the table's test checks
+the shader hash, and each preset's own digest, so a stale merge fails there).
 """
 
 from __future__ import annotations
@@ -112,7 +117,11 @@ def main() -> None:
     parser.add_argument("--from-results", action="store_true",
                         help=f"re-write the outputs from {RAW.relative_to(ROOT)}")
     parser.add_argument("--time-tiers", action="store_true",
-                        help="with --from-results: time the tiers against draft again")
+                        help="with --from-results: time the tiers against draft again "
+                             "(with --presets: those presets' only)")
+    parser.add_argument("--merge", action="store_true",
+                        help="with --presets: replace those presets' rows in the last run's "
+                             "results and keep the others'")
     parser.add_argument("--write-table", action="store_true",
                         help=f"also write {TABLE_PATH.relative_to(ROOT)}")
     parser.add_argument("--out", type=Path, default=DOCS, help="where accuracy.* go")
@@ -124,20 +133,47 @@ def main() -> None:
         data = json.loads(RAW.read_text())
         if args.time_tiers:
             bench = Bench(data["info"]["size"])
+            started = time.perf_counter()
             try:
-                names = list(dict.fromkeys(r["preset"] for r in data["rows"]))
-                data["tier_ratios"] = time_tiers(bench, names)
+                names = args.presets or list(dict.fromkeys(r["preset"] for r in data["rows"]))
+                data["tier_ratios"] = {**data.get("tier_ratios", {}),
+                                       **time_tiers(bench, names)}
             finally:
                 bench.release()
+            data["info"].setdefault("retimed", []).append({
+                "command": " ".join(["python bench/accuracy.py", *sys.argv[1:]]),
+                "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+                "wall_s": time.perf_counter() - started})
             write_atomic(RAW, json.dumps(data, indent=1).encode())
     else:
         names = args.presets or list(all_presets())
         unknown = [n for n in names if n not in all_presets()]
         if unknown:
             parser.error(f"unknown presets {unknown}; known: {', '.join(all_presets())}")
+        if args.merge and not args.presets:
+            parser.error("--merge needs --presets: the presets to measure again")
+        if args.merge and not RAW.is_file():  # before the hour of measuring, not after
+            parser.error(f"--merge: no last run to merge into ({RAW.relative_to(ROOT)})")
         data = run(names, args.size, [] if args.base_only else list(VARIANTS[1:]))
+        if args.merge:
+            data = merged(json.loads(RAW.read_text()), data, names)
         write_atomic(RAW, json.dumps(data, indent=1).encode())
     write_outputs(data, args.out, args.write_table)
+
+
+def merged(old: dict, new: dict, names: list[str]) -> dict:
+    """The last run's results with ``names``' rows, facts and tier ratios from ``new``; the
+    info is the last run's, with this run noted (what it measured, when, how long)."""
+    if old["info"]["size"] != new["info"]["size"]:
+        raise SystemExit(f"--merge: the last run was at {old['info']['size']}², "
+                         f"this one at {new['info']['size']}²")
+    keep = set(names)
+    info = {**old["info"], "merged": [*old["info"].get("merged", []), {
+        key: new["info"][key] for key in ("command", "date", "wall_s", "load")}]}
+    return {"info": info,
+            "rows": [r for r in old["rows"] if r["preset"] not in keep] + new["rows"],
+            "facts": [f for f in old["facts"] if f["preset"] not in keep] + new["facts"],
+            "tier_ratios": {**old.get("tier_ratios", {}), **new["tier_ratios"]}}
 
 
 def write_outputs(data: dict, out: Path, table: bool) -> None:

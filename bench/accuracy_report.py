@@ -158,7 +158,11 @@ def to_markdown(rows: list[dict], facts: list[dict], info: dict, guide: str) -> 
         f"Measured by `{info['command']}` on {info['date']} in {info['wall_s']:.0f} s. "
         f"Machine: {info['cpu']}; {info['platform']}; GL: {info['gl']}; Python {info['python']}. "
         f"Load average (1 min) at start / end: {info['load'][0]:.1f} / {info['load'][1]:.1f} "
-        "(the machine is shared: load inflates times, not errors).",
+        "(the machine is shared: load inflates times, not errors)."
+        + "".join(f" Then `{m['command']}` on {m['date']} in {m['wall_s']:.0f} s measured those "
+                  "presets again, the others' rows kept." for m in info.get("merged", []))
+        + "".join(f" Then `{m['command']}` on {m['date']} in {m['wall_s']:.0f} s timed the "
+                  "tiers against draft again." for m in info.get("retimed", [])),
         "",
         f"Images are {info['size']}² display (sRGB) images of each preset's own material. Grid: "
         f"samples {', '.join(map(str, SAMPLES))} × wavelengths "
