@@ -20,7 +20,7 @@ from opaline.output import files
 PRESETS = ("cd-rom", "cd-rom-wide", "cd-rom-ashikhmin", "perturbed-cube", "nacre", "oil-slick",
            "oil-slick-soft", "sphere", "oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating",
            "nacre-film", "anodised-titanium", "tempered-steel", "tempered-copper", "bragg-mirror",
-           "coated-paint")
+           "morpho", "coated-paint")
 # docs/design.md §5 ranges (and exposure, light angles), written out independently of params.py.
 RANGES = {
     "ex": (0, 1e6), "ey": (0, 1e6), "mu_f": (0, 1000), "alpha": (0, 1000), "beta": (0, 1000),
@@ -158,7 +158,7 @@ def test_render_help_lists_choices(capsys):
 
 
 def test_presets_lists_all(capsys):
-    """`presets` lists the paper's eight presets and the nine physical ones, one entry each."""
+    """`presets` lists the paper's eight presets and the eleven physical ones, one entry each."""
     code, out, _ = run(capsys, "presets")
     assert code == 0
     named = [line.split()[0] for line in out.splitlines() if line and not line[0].isspace()]

@@ -84,15 +84,15 @@ def test_every_file_loads():
 
 PHYSICAL = {"oil-film", "soap-bubble", "cd-rom-grating", "dvd-grating", "nacre-film",
             "anodised-titanium", "tempered-steel", "tempered-copper",  # films on metals: issue 23
-            "bragg-mirror",  # a stack: issue 23
+            "bragg-mirror", "morpho",  # stacks: issue 23
             "coated-paint"}  # a film under a clear coat: issue 23
 
 
 def test_preset_names_are_the_eight_of_design_and_the_physical_ones():
     """The presets are exactly the eight of docs/design.md §6, the five physical ones (issue
-    14), the three films on metals, the stack and the coated paint (issue 23)."""
+    14), the three films on metals, the two stacks and the coated paint (issue 23)."""
     assert set(all_presets()) == set(PAPER) | PHYSICAL
-    assert len(all_presets()) == 18
+    assert len(all_presets()) == 19
 
 
 @pytest.mark.parametrize("name", sorted(PAPER))

@@ -83,6 +83,8 @@ def test_a_film_takes_its_own_wavelengths_from_the_tier(tier):
     want = TIERS[tier]
     film = resolve(RenderRequest(preset="oil-film", quality=tier))
     metal = resolve(RenderRequest(preset="tempered-steel", quality=tier))
+    stack = resolve(RenderRequest(preset="bragg-mirror", quality=tier))
+    assert stack.wavelengths == want.stack_wavelengths
     rotation = resolve(RenderRequest(preset="sphere", quality=tier))
     assert film.wavelengths == want.film_wavelengths
     assert metal.wavelengths == want.metal_film_wavelengths
@@ -92,6 +94,11 @@ def test_a_film_takes_its_own_wavelengths_from_the_tier(tier):
                    ).wavelengths == want.film_wavelengths
     assert TIERS["draft"].film_wavelengths == 0 and TIERS["standard"].film_wavelengths == 0
     assert TIERS["standard"].metal_film_wavelengths == 16
+    # Over 8 samples 16 wavelengths a sample leave colour noise on films and stacks (the
+    # accuracy grid): high takes 32.
+    assert TIERS["high"].film_wavelengths == TIERS["high"].metal_film_wavelengths == 32
+    # A stack's 16-bin fast path at standard left morpho at FLIP 0.061: 32 wavelengths.
+    assert TIERS["standard"].stack_wavelengths == 32
 
 
 def test_tiers_are_ordered():

@@ -114,7 +114,8 @@ class RenderFields(MaterialFields, SceneFields):
         json_schema_extra=wavelengths_schema,
         description="0 = the paper's RGB rotations (a film's RGB fast path), else 4 … 128 "
         "wavelengths integrated with CIE 1931 under D65 (default: the tier's; a thin film "
-        "takes the tier's film_wavelengths, on a metal its metal_film_wavelengths: "
+        "takes the tier's film_wavelengths, on a metal its metal_film_wavelengths, a "
+        "stack its stack_wavelengths: "
         "GET /v1/tiers).",
     )
     aa: AntiAlias | None = Field(

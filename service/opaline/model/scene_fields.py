@@ -69,7 +69,7 @@ class SceneFields(BaseModel):
                           f"{BUILT_IN}, or an .hdr/.exr file of the environments folder; "
                           f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: the "
                           "preset's (none on most; studio on soap-bubble, the films on "
-                          f"metals, bragg-mirror and coated-paint), '{MESH_ENVIRONMENT}' on a "
+                          f"metals, the stacks and coated-paint), '{MESH_ENVIRONMENT}' on a "
                           "user's mesh.",
         examples=[*BUILTIN, NO_ENVIRONMENT])
     environment_rotation: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(

@@ -62,9 +62,19 @@ class Tier:
     # reference (bench/white_point.py, ΔE00 mean / worst), on a dielectric the RGB fast
     # path (0) measured 0.10 / 1.5, 16 wavelengths 0.46 / 22 and 8 4.9 / 32 (thick films
     # alias into false colours); on a metal the fast path 1.6 / 12, 16 wavelengths
-    # 0.37 / 7.0 and 8 3.2 / 35. Each tier takes the closest its cost allows.
+    # 0.37 / 7.0 and 8 3.2 / 35. Each tier takes the closest its cost allows. Over many
+    # samples the wavelengths move from sample to sample, and 16 a sample leave colour noise
+    # that 32 do not: at 8 samples (bench/accuracy.py, 128², every film preset and variant)
+    # FLIP 0.0099-0.0268 with 16 against 0.0049-0.0151 with 32, every one lower, the stacks
+    # and the copper most (0.026 to 0.011, 0.020 to 0.013), for 1.14-1.3× the time under
+    # the key light and 1.5-1.9× in the studio (each of high's map reads evaluates the film).
     film_wavelengths: int
     metal_film_wavelengths: int
+    # A stack of layers (film_stack_pairs > 0): its fast path integrates 16 bins, and its
+    # narrow stop bands want more (the accuracy grid, 128², in the studio): at one sample
+    # morpho 0.061 by the bins against 0.030 at 32 wavelengths, bragg-mirror 0.030 against
+    # 0.015, for 1.0-1.05× the time where the map's light dominates.
+    stack_wavelengths: int
     measured: Measured | None = None  # quality=auto only
 
     def wavelengths_for(self, material: Material | None) -> int:
@@ -72,6 +82,8 @@ class Tier:
         grating's without one)."""
         if material is None or material.iridescence != "thin-film":
             return self.wavelengths
+        if material.film_stack_pairs > 0:
+            return self.stack_wavelengths
         if material.substrate == "conductor":
             return self.metal_film_wavelengths
         return self.film_wavelengths
@@ -87,6 +99,7 @@ class Tier:
         return {"name": self.name, **self.render_settings(),
                 "film_wavelengths": self.film_wavelengths,
                 "metal_film_wavelengths": self.metal_film_wavelengths,
+                "stack_wavelengths": self.stack_wavelengths,
                 "environment_lights": self.environment_lights,
                 "environment_samples": self.environment_samples,
                 "environment_samples_rotation": self.environment_samples_rotation,
@@ -100,20 +113,25 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # little more than one RGB sample and has a third to half of its error.
     Tier("draft", samples=1, wavelengths=8, aa="analytic",
          environment_lights=8, environment_samples=2, environment_samples_rotation=3,
-         environment_samples_grating=1, film_wavelengths=0, metal_film_wavelengths=0),
+         environment_samples_grating=1, film_wavelengths=0, metal_film_wavelengths=0,
+         stack_wavelengths=0),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
          environment_lights=16, environment_samples=6, environment_samples_rotation=9,
-         environment_samples_grating=3, film_wavelengths=0, metal_film_wavelengths=16),
-    # FLIP <= 0.01 on every preset; the wavelengths move between samples (spectrum.py).
+         environment_samples_grating=3, film_wavelengths=0, metal_film_wavelengths=16,
+         stack_wavelengths=32),
+    # FLIP <= 0.01 on the paper's presets; the wavelengths move between samples
+    # (spectrum.py), 32 a sample on a film.
     Tier("high", samples=8, wavelengths=16, aa="none",
          environment_lights=32, environment_samples=64, environment_samples_rotation=64,
-         environment_samples_grating=32, film_wavelengths=16, metal_film_wavelengths=16),
+         environment_samples_grating=32, film_wavelengths=32, metal_film_wavelengths=32,
+         stack_wavelengths=32),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
     Tier("reference", samples=64, wavelengths=32, aa="none",
          environment_lights=64, environment_samples=1024, environment_samples_rotation=1024,
-         environment_samples_grating=512, film_wavelengths=32, metal_film_wavelengths=32),
+         environment_samples_grating=512, film_wavelengths=32, metal_film_wavelengths=32,
+         stack_wavelengths=32),
 )}
 if tuple(TIERS) != get_args(TierName):  # the Literal is what the schema and mypy read
     raise AssertionError(f"TierName {get_args(TierName)} does not list the tiers {tuple(TIERS)}")
@@ -135,4 +153,4 @@ def auto_tier(samples: int, wavelengths: int, aa: AntiAliasName, measured: Measu
                 max(like.environment_samples, high.environment_samples),
                 max(like.environment_samples_rotation, high.environment_samples_rotation),
                 max(like.environment_samples_grating, high.environment_samples_grating),
-                wavelengths, wavelengths, measured)
+                wavelengths, wavelengths, wavelengths, measured)

@@ -59,6 +59,9 @@ class TierInfo(BaseModel):
                                               "integrated at (0: the RGB fast path, closed "
                                               "form over the colour weights).")
     metal_film_wavelengths: int = Field(description="The same for a film on a conductor.")
+    stack_wavelengths: int = Field(description="The same for a stack of layers "
+                                               "(film_stack_pairs > 0; 0: its 16-bin fast "
+                                               "path).")
     aa: str = Field(description="Anti-aliasing: 'analytic' or 'none'.")
     environment_lights: int = Field(description="Directional lights an environment becomes "
                                                 "where it is drawn as lights.")
