@@ -65,9 +65,12 @@ class Tier:
     # 0.37 / 7.0 and 8 3.2 / 35. Each tier takes the closest its cost allows. Over many
     # samples the wavelengths move from sample to sample, and 16 a sample leave colour noise
     # that 32 do not: at 8 samples (bench/accuracy.py, 128², every film preset and variant)
-    # FLIP 0.0099-0.0268 with 16 against 0.0049-0.0151 with 32, every one lower, the stacks
-    # and the copper most (0.026 to 0.011, 0.020 to 0.013), for 1.14-1.3× the time under
-    # the key light and 1.5-1.9× in the studio (each of high's map reads evaluates the film).
+    # FLIP 0.0099-0.0268 with 16 against 0.0049-0.0151 with 32, every one lower, for
+    # 1.14-1.3× the time under the key light and 1.5-1.9× in the studio (each of high's
+    # map reads evaluates the film). On a dielectric high takes 32. On a metal it keeps 16:
+    # the gain is smaller (0.010-0.020 to 0.007-0.013) and 32 took the metals in the studio
+    # to 1.9-2.0× draft's time, past the 2× in which a tier must meet FLIP 0.05 (at their
+    # own light, anodised-titanium's draft and standard do not).
     film_wavelengths: int
     metal_film_wavelengths: int
     # A stack of layers (film_stack_pairs > 0): its fast path integrates 16 bins, and its
@@ -124,7 +127,7 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
     # (spectrum.py), 32 a sample on a film.
     Tier("high", samples=8, wavelengths=16, aa="none",
          environment_lights=32, environment_samples=64, environment_samples_rotation=64,
-         environment_samples_grating=32, film_wavelengths=32, metal_film_wavelengths=32,
+         environment_samples_grating=32, film_wavelengths=32, metal_film_wavelengths=16,
          stack_wavelengths=32),
     # The converged target: brute force, no analytic approximation; within FLIP 0.01 of twice
     # its samples and wavelengths even at theta = ±2π.
