@@ -14,6 +14,7 @@ are trimesh's area-weighted vertex normals; tangents are ``tangents.tangent_fram
 
 from __future__ import annotations
 
+import importlib
 import io
 import re
 from collections import OrderedDict
@@ -186,6 +187,10 @@ def load_mesh_file(path: str | Path, field: str = "auto",
         data = path.read_bytes()
     except OSError as exc:
         raise MeshError(f"cannot read mesh {path.name}: {exc.strerror or exc}") from None
+    # The parser's own imports (trimesh pulls in scipy) before the ceiling: the headroom
+    # bounds the file's data, and a fresh worker importing under it failed with
+    # SystemError instead of MemoryError.
+    importlib.import_module("trimesh")
     try:
         with parse_ceiling():
             found = parse_mesh(data, path.suffix, field, axis, max_triangles)
