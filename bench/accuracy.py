@@ -56,15 +56,19 @@ def machine(bench: Bench) -> dict[str, str]:
             "python": platform.python_version()}
 
 
+def invocation() -> dict[str, str]:
+    """This run's command line and start, as the report cites them."""
+    return {"command": " ".join(["python bench/accuracy.py", *sys.argv[1:]]),
+            "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")}
+
+
 def run(names: list[str], size: int, variants: list[str]) -> dict:
     from opaline.model.presets import all_presets
 
     presets = all_presets()
     started = time.perf_counter()
     bench = Bench(size)
-    info = {**machine(bench), "size": size, "load": [os.getloadavg()[0]],
-            "command": " ".join(["python bench/accuracy.py", *sys.argv[1:]]),
-            "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")}
+    info = {**machine(bench), "size": size, "load": [os.getloadavg()[0]], **invocation()}
     rows, facts = [], []
     try:
         for name in names:
@@ -133,40 +137,46 @@ def main() -> None:
         data = json.loads(RAW.read_text())
         if args.time_tiers:
             bench = Bench(data["info"]["size"])
-            started = time.perf_counter()
+            stamp, started = invocation(), time.perf_counter()
             try:
                 names = args.presets or list(dict.fromkeys(r["preset"] for r in data["rows"]))
                 data["tier_ratios"] = {**data.get("tier_ratios", {}),
                                        **time_tiers(bench, names)}
             finally:
                 bench.release()
-            data["info"].setdefault("retimed", []).append({
-                "command": " ".join(["python bench/accuracy.py", *sys.argv[1:]]),
-                "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
-                "wall_s": time.perf_counter() - started})
+            data["info"].setdefault("retimed", []).append(
+                {**stamp, "wall_s": time.perf_counter() - started})
             write_atomic(RAW, json.dumps(data, indent=1).encode())
     else:
         names = args.presets or list(all_presets())
         unknown = [n for n in names if n not in all_presets()]
         if unknown:
             parser.error(f"unknown presets {unknown}; known: {', '.join(all_presets())}")
-        if args.merge and not args.presets:
-            parser.error("--merge needs --presets: the presets to measure again")
-        if args.merge and not RAW.is_file():  # before the hour of measuring, not after
-            parser.error(f"--merge: no last run to merge into ({RAW.relative_to(ROOT)})")
+        last = last_run(parser, args) if args.merge else None
         data = run(names, args.size, [] if args.base_only else list(VARIANTS[1:]))
-        if args.merge:
-            data = merged(json.loads(RAW.read_text()), data, names)
+        if last is not None:
+            data = merged(last, data, names)
         write_atomic(RAW, json.dumps(data, indent=1).encode())
     write_outputs(data, args.out, args.write_table)
+
+
+def last_run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> dict:
+    """The results --merge keeps, refused before the hour of measuring, not after: none
+    named, none there, or another size."""
+    if not args.presets:
+        parser.error("--merge needs --presets: the presets to measure again")
+    if not RAW.is_file():
+        parser.error(f"--merge: no last run to merge into ({RAW.relative_to(ROOT)})")
+    last: dict = json.loads(RAW.read_text())
+    if last["info"]["size"] != args.size:
+        parser.error(f"--merge: the last run was at {last['info']['size']}², "
+                     f"this one would be at {args.size}²")
+    return last
 
 
 def merged(old: dict, new: dict, names: list[str]) -> dict:
     """The last run's results with ``names``' rows, facts and tier ratios from ``new``; the
     info is the last run's, with this run noted (what it measured, when, how long)."""
-    if old["info"]["size"] != new["info"]["size"]:
-        raise SystemExit(f"--merge: the last run was at {old['info']['size']}², "
-                         f"this one at {new['info']['size']}²")
     keep = set(names)
     info = {**old["info"], "merged": [*old["info"].get("merged", []), {
         key: new["info"][key] for key in ("command", "date", "wall_s", "load")}]}
