@@ -77,3 +77,33 @@ def test_no_headroom_no_ceiling(headroom):
     headroom(None)
     with parse_ceiling():
         assert np.ones(256 << 20, dtype=np.uint8).size == 256 << 20
+
+
+REFUSE_IN_A_FRESH_PROCESS = """
+import sys
+from opaline.scene.meshfile import MeshError, load_mesh_file
+from opaline.scene.parse_memory import PARSE_HEADROOM_BYTES, limit_parse_memory
+limit_parse_memory(PARSE_HEADROOM_BYTES)
+try:
+    load_mesh_file(sys.argv[1])
+except MeshError as exc:
+    print(exc)
+print("trimesh" in sys.modules, "scipy" in sys.modules)
+"""
+
+
+def test_a_file_the_cheap_checks_refuse_never_imports_the_parser(tmp_path):
+    """The check lane's worker refuses hostile files without trimesh and scipy (~170 MB of
+    it): importing them ahead of every parse grew that worker past the HTTP test's bound."""
+    import subprocess
+
+    from hostile_meshes import glb_claiming_vertices
+
+    path = tmp_path / "claims.glb"
+    path.write_bytes(glb_claiming_vertices())
+    run = subprocess.run([sys.executable, "-c", REFUSE_IN_A_FRESH_PROCESS, str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    refused, imported = run.stdout.splitlines()[-2:]
+    assert "limit of 6000000" in refused, run.stdout
+    assert imported == "False False"

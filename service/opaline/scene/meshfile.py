@@ -108,6 +108,14 @@ def parse_mesh(data: bytes, suffix: str = "", field: str = "auto",
                axis: Sequence[float] = (0.0, 1.0, 0.0),
                max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
     """A renderable ``Mesh`` and a summary (format, counts, bounds, tangent field used)."""
+    data, fmt = admit(data, suffix, max_triangles)
+    return build_mesh(data, fmt, field, axis, max_triangles)
+
+
+def admit(data: bytes, suffix: str = "",
+          max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[bytes, str]:
+    """The bytes to parse and their format, once the cheap checks (the format, a film's
+    textures, the counts the file declares) pass: MeshError on any, before trimesh."""
     if not data:
         raise MeshError("empty file: expected a glTF/GLB, OBJ, PLY or STL mesh")
     fmt = sniff(data, suffix)
@@ -120,6 +128,14 @@ def parse_mesh(data: bytes, suffix: str = "", field: str = "auto",
         data = meshlimits.check(data, fmt, max_triangles)  # (a .glb's images left out)
     except meshlimits.LimitError as exc:
         raise MeshError(str(exc)) from None
+    return data, fmt
+
+
+def build_mesh(data: bytes, fmt: str, field: str = "auto",
+               axis: Sequence[float] = (0.0, 1.0, 0.0),
+               max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
+    """``parse_mesh`` of bytes that ``admit`` passed: trimesh's parse, then the checks of
+    what it built (counts, indices, finite and drawable coordinates, some area)."""
     loaded = _parse(data, fmt)
     faces = np.asarray(loaded.faces, dtype=np.int64)
     positions = np.asarray(loaded.vertices, dtype=np.float64)
@@ -187,13 +203,16 @@ def load_mesh_file(path: str | Path, field: str = "auto",
         data = path.read_bytes()
     except OSError as exc:
         raise MeshError(f"cannot read mesh {path.name}: {exc.strerror or exc}") from None
-    # The parser's own imports (trimesh pulls in scipy) before the ceiling: the headroom
-    # bounds the file's data, and a fresh worker importing under it failed with
-    # SystemError instead of MemoryError.
-    importlib.import_module("trimesh")
     try:
         with parse_ceiling():
-            found = parse_mesh(data, path.suffix, field, axis, max_triangles)
+            data, fmt = admit(data, path.suffix, max_triangles)
+        # The parser's imports (trimesh pulls in scipy, ~170 MB) outside the ceiling, so the
+        # headroom bounds the file's data alone (a fresh worker importing under a small one
+        # failed with SystemError), and only once the cheap checks pass: a worker that only
+        # ever refuses files never grows by them.
+        importlib.import_module("trimesh")
+        with parse_ceiling():
+            found = build_mesh(data, fmt, field, axis, max_triangles)
     except MemoryError:
         headroom = (parse_headroom() or 0) >> 20
         raise MeshError(f"mesh {path.name} needs more than {headroom} MB to read, over this "
