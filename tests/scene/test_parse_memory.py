@@ -52,16 +52,22 @@ print(load_mesh_file(sys.argv[1], field="concentric")[1]["triangles"])
 """
 
 
+def last_two_lines(script: str, path) -> list[str]:
+    """The last two lines ``script`` prints, run in a fresh Python on ``path``."""
+    import subprocess
+
+    run = subprocess.run([sys.executable, "-c", script, str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert len(run.stdout.splitlines()) >= 2, run.stdout
+    return run.stdout.splitlines()[-2:]
+
+
 def test_a_parse_past_its_headroom_is_refused_and_the_limit_put_back(big_ply):
     """In a fresh process: a long-lived one may hold freed memory the parse reuses without
     growing its address space, so the same headroom need not be reached there."""
-    import subprocess
-
-    run = subprocess.run([sys.executable, "-c", PARSE_IN_A_FRESH_PROCESS, str(big_ply)],
-                         capture_output=True, text=True, timeout=120)
-    assert run.returncode == 0, run.stderr[-2000:]
-    refused, parsed = run.stdout.splitlines()[-2:]
-    assert "needs more than 16 MB to read" in refused, run.stdout
+    refused, parsed = last_two_lines(PARSE_IN_A_FRESH_PROCESS, big_ply)
+    assert "needs more than 16 MB to read" in refused
     assert parsed == "327680"
 
 
@@ -95,15 +101,10 @@ print("trimesh" in sys.modules, "scipy" in sys.modules)
 def test_a_file_the_cheap_checks_refuse_never_imports_the_parser(tmp_path):
     """The check lane's worker refuses hostile files without trimesh and scipy (~170 MB of
     it): importing them ahead of every parse grew that worker past the HTTP test's bound."""
-    import subprocess
-
     from hostile_meshes import glb_claiming_vertices
 
     path = tmp_path / "claims.glb"
     path.write_bytes(glb_claiming_vertices())
-    run = subprocess.run([sys.executable, "-c", REFUSE_IN_A_FRESH_PROCESS, str(path)],
-                         capture_output=True, text=True, timeout=120)
-    assert run.returncode == 0, run.stderr[-2000:]
-    refused, imported = run.stdout.splitlines()[-2:]
-    assert "limit of 6000000" in refused, run.stdout
+    refused, imported = last_two_lines(REFUSE_IN_A_FRESH_PROCESS, path)
+    assert "limit of 6000000" in refused
     assert imported == "False False"
