@@ -1,6 +1,6 @@
-//! defines: TONEMAP_REINHARD TONEMAP_ACES TONEMAP_NEUTRAL TRANSPARENT DOWNSAMPLE_2X
-// Averages the accumulated samples and encodes for display: exposure, tone map,
-// sRGB; composited over the background unless the output keeps its alpha.
+//! defines: TONEMAP_REINHARD TONEMAP_ACES TONEMAP_NEUTRAL TRANSFER_BT709 TRANSPARENT DOWNSAMPLE_2X
+// Averages the accumulated samples and encodes for display: exposure, the output's
+// primaries and gamut, tone map, transfer curve; composited over the background unless the output keeps its alpha.
 // Rows are written top row first (the reverse of GL's order), so the readback
 // is already in image order; an 8-bit target quantises in GL, rounding to nearest.
 #include "fullscreen.glsl"
@@ -11,7 +11,7 @@
 uniform sampler2D u_accum;
 uniform float u_inv_samples;
 uniform float u_exposure;
-uniform vec3 u_background;  // display-referred sRGB
+uniform vec3 u_background;  // display-referred, in the output's colour space
 uniform int u_height;  // of the target, for the row flip
 
 out vec4 frag_color;
@@ -29,7 +29,7 @@ void main() {
 #endif
     float coverage = clamp(acc.a, 0.0, 1.0);
     vec3 straight = coverage > 0.0 ? acc.rgb / coverage : vec3(0.0);
-    vec3 display = srgb_encode(tonemap(straight * u_exposure));
+    vec3 display = display_encode(straight * u_exposure);
 #ifdef TRANSPARENT
     frag_color = vec4(display, coverage);
 #else

@@ -222,7 +222,7 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
 #endif
 #ifdef ENV_ENVELOPE
     // Each wavelength once a pass: the sum is the pass's estimate of the bands.
-    return max(sum + specular_envelope(mat, env, vec3(frame[2]), v), vec3(0.0));
+    return sum + specular_envelope(mat, env, vec3(frame[2]), v);
 #else
     return sum / float(ENV_SAMPLES);
 #endif

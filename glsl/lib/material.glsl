@@ -97,8 +97,8 @@ vec3 mdf_color(Material mat, real2 h, float hz) {
     for (int i = 0; i < WAVELENGTHS; ++i) {
         sum += u_spectral_weight[i] * mdf(mat, rotate_half(h, u_spectral_rotation[i]), hz);
     }
-    // Colour matching weights go negative outside the sRGB gamut; radiance may not.
-    return max(sum, vec3(0.0));
+    // A channel below 0 (a colour outside sRGB) is kept to the display's gamut map.
+    return sum;
 }
 #else
 vec3 mdf_color(Material mat, real2 h, float hz) {

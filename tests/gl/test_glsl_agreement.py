@@ -130,13 +130,17 @@ def test_no_specular_when_light_is_opposite_view(renderer):
     assert np.allclose(gl[0], expected, rtol=1e-5)
 
 
-@pytest.mark.parametrize("tonemap", ["none", "reinhard", "aces", "neutral"])
-def test_display_encoding_matches_reference(renderer, tonemap):
-    """The resolve's exposure, tone map and sRGB agree with the float64 twin (model/display.py)
-    on the renderer's own linear radiance, over pixels below and above neutral's knee."""
+@pytest.mark.parametrize(("tonemap", "space"), [
+    ("none", "srgb"), ("reinhard", "srgb"), ("aces", "srgb"), ("neutral", "srgb"),
+    ("neutral", "display-p3"), ("none", "rec2020")])
+def test_display_encoding_matches_reference(renderer, tonemap, space):
+    """The resolve's exposure, output primaries, gamut map, tone map and transfer curve agree
+    with the float64 twin (model/display.py) on the renderer's own linear radiance, over
+    pixels below and above neutral's knee and pixels outside sRGB (the CD's spectral
+    colours)."""
     from dataclasses import replace
 
-    from opaline.model.display import KS
+    from opaline.model.display import KS, display_encode
     from opaline.model.presets import get_preset
     from opaline.model.request import resolve
 
@@ -145,12 +149,13 @@ def test_display_encoding_matches_reference(renderer, tonemap):
                                 transparent=True, tonemap=tonemap, exposure=exposure,
                                 format="npy"), get_preset("cd-rom"))
     linear = renderer.render(job).linear.astype(np.float64)
-    display = renderer.render(replace(job, format="png16")).display
+    display = renderer.render(replace(job, format="png16", color_space=space)).display
     coverage = linear[..., 3]
     covered = coverage > 0.0
     straight = linear[covered, :3] / coverage[covered, None] * exposure
     peaks = straight.max(axis=1)
     assert (peaks < KS).sum() > 50 and (peaks > 2.0).sum() > 50  # both branches exercised
-    expected = ref.srgb_encode(ref.tonemap(straight, tonemap))
+    assert (straight.min(axis=1) < -1e-3).sum() > 20  # and the gamut map
+    expected = display_encode(straight, tonemap, space)
     assert np.abs(display[covered, :3] - expected).max() < 1e-4
     assert np.allclose(display[..., 3], np.clip(coverage, 0.0, 1.0), atol=1e-6)

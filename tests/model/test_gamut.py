@@ -1,11 +1,12 @@
-"""What Opaline does with a colour outside sRGB (docs/physics.md §1.4, "Gamut"): each linear sRGB
-channel of a spectral sum that comes out below 0 is set to 0, the others kept, on the
-spectral path and on the fast path alike.
+"""What Opaline does with a colour outside sRGB (docs/physics.md §1.4, "Gamut"): the
+spectral sums and the fast path keep a channel below 0, and the display encoding moves
+the colour toward the grey of its luminance (model/color_space.py), or shows it in a
+wider space.
 
 The exact colour is colour-science's: ``thin_film_tmm`` at every nm under D65, to XYZ
 and linear sRGB. A free soap film 460 nm thick seen face-on is a dim cyan that sRGB
-cannot hold (its red channel is below 0); those tests fail if the shader's twin stops
-clipping, maps the gamut another way or lets the negative channel through.
+cannot hold (its red channel is below 0); those tests fail if the twin clips the channel
+at the sum again.
 """
 
 from __future__ import annotations
@@ -50,16 +51,30 @@ def out_of_gamut_case() -> tuple[float, float, np.ndarray]:
     raise AssertionError("no free-film colour out of sRGB on the scan")
 
 
-def test_the_spectral_path_clips_each_negative_channel_and_keeps_the_others():
+def test_the_spectral_path_keeps_the_negative_channel_to_the_display():
     thickness, angle, exact = out_of_gamut_case()
     cos1 = np.cos(np.radians(angle))
     ours = thinfilm.film_rgb_spectral(cos1, thickness, *SOAP, 128)
-    assert ours[0] == 0.0  # clipped, not mapped: the red channel alone goes to 0
-    np.testing.assert_allclose(ours[1:], exact[1:], atol=2e-3)  # green and blue as exact
+    np.testing.assert_allclose(ours, exact, atol=2e-3)  # red below 0 included
+    assert ours[0] < -0.01
 
 
-def test_the_fast_path_clips_the_same_colour():
+def test_the_fast_path_keeps_it_too():
     thickness, angle, exact = out_of_gamut_case()
     fast = thinfilm.film_rgb_fast(np.cos(np.radians(angle)), thickness, *SOAP)
-    assert fast[0] == 0.0
-    np.testing.assert_allclose(fast[1:], exact[1:], atol=0.01)
+    np.testing.assert_allclose(fast, exact, atol=0.01)
+    assert fast[0] < 0.0
+
+
+def test_rec2020_shows_the_exact_colour():
+    """The same cyan lies outside Display P3 too (its red there is -0.009) but inside
+    Rec. 2020: encoded there it decodes to the exact colour."""
+    from opaline.model import color_space
+    from opaline.model.display import display_encode
+
+    thickness, angle, exact = out_of_gamut_case()
+    ours = thinfilm.film_rgb_spectral(np.cos(np.radians(angle)), thickness, *SOAP, 128)
+    wide = exact @ color_space.from_srgb("rec2020").T
+    assert wide.min() > 0.0 and (exact @ color_space.from_srgb("display-p3").T).min() < 0.0
+    shown = color_space.decode(display_encode(ours, "none", "rec2020"), "rec2020")
+    np.testing.assert_allclose(shown, wide, atol=3e-3)

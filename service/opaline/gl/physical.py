@@ -25,12 +25,15 @@ def thickness_texture(ctx: moderngl.Context,
     return texture
 
 
-def backdrop_radiance(background: Sequence[float], tonemap: str,
-                      exposure: float) -> tuple[float, ...]:
-    """The linear radiance that displays as the preset's background colour after exposure,
-    tone map and sRGB encoding: what a film that transmits everything lets through."""
-    from opaline.model.display import srgb_decode, tonemap_inverse
+def backdrop_radiance(background: Sequence[float], tonemap: str, exposure: float,
+                      space: str = "srgb") -> tuple[float, ...]:
+    """The linear sRGB radiance that displays as the preset's background colour after
+    exposure, tone map and the output's encoding: what a film that transmits everything
+    lets through."""
+    from opaline.model import color_space
+    from opaline.model.display import tonemap_inverse
 
-    y = np.clip(srgb_decode(np.asarray(background, dtype=np.float64)), 0.0, 0.999)
-    x = tonemap_inverse(y, tonemap)
+    shown = color_space.display_background(background, space)
+    y = np.clip(color_space.decode(shown, space), 0.0, 0.999)
+    x = np.linalg.solve(color_space.from_srgb(space), tonemap_inverse(y, tonemap))
     return tuple(float(v) for v in x / exposure)

@@ -112,7 +112,8 @@ class Renderer:
             fbo, source = drawn.accum_fbo, drawn.accum_tex
         if job.format == "npy":
             linear = passes.downsample(read_float(fbo, drawn.size), samples.factor)
-            return Frame(linear=linear / np.float32(samples.samples), display=None)
+            return Frame(linear=in_space(linear / np.float32(samples.samples), job.color_space),
+                         display=None)
         targets = self.targets(size)
         if job.format == "png16":
             self.resolver.resolve(job, preset, source, targets.display_fbo, samples)
@@ -126,3 +127,15 @@ class Renderer:
         self.environments.release()
         self.resources.release()
         self.gl.release()
+
+
+def in_space(linear: np.ndarray, space: str) -> np.ndarray:
+    """Linear sRGBA as linear RGBA in ``space``'s primaries (unmapped: a colour outside it
+    keeps a channel below 0)."""
+    if space == "srgb":
+        return linear
+    from opaline.model.color_space import from_srgb
+
+    out = linear.copy()
+    out[..., :3] = linear[..., :3] @ from_srgb(space).T.astype(np.float32)
+    return out

@@ -27,7 +27,7 @@ from opaline.gl import (
 from opaline.gl.background import Backgrounds
 from opaline.gl.buffers import Cancelled, SceneGPU, Targets
 from opaline.gl.lighting import light_uniforms
-from opaline.gl.resolve import tonemap_defines
+from opaline.gl.resolve import display_defines, display_uniforms
 from opaline.gl.resources import Resources
 from opaline.model.camera import fit_matrix, model_matrix, view_camera, view_projection
 from opaline.model.environment_light import reads_map
@@ -106,7 +106,7 @@ class SurfacePass:
         if scene.projection is not None:
             defines["OBJECT_PROJECTION"] = True
         if plan.display:
-            defines.update(DISPLAY=True, **tonemap_defines(job))
+            defines.update(DISPLAY=True, **display_defines(job))
         defines.update(dict.fromkeys(plan.forced, True))
         lights = self._light(job, preset, plan, defines)
         program = self.resources.programs.get("surface.glsl", defines)
@@ -123,6 +123,7 @@ class SurfacePass:
             "u_ambient": (0.0, 0.0, 0.0) if job.environment else tuple(preset.ambient),
             "u_aa_scale": plan.samples.aa_scale,
             "u_exposure": job.exposure,
+            **display_uniforms(job),
             **heightfield.uniforms(preset),
             "u_projection": scene.projection or (0.0, 0.0, 0.0, 1.0),
         })
@@ -158,7 +159,7 @@ class SurfacePass:
             normal_map.use(location=texture_units.NORMAL_MAP)
         if defines.get("TRANSMISSION"):
             values["u_backdrop"] = physical.backdrop_radiance(
-                preset.background, job.tonemap, job.exposure)
+                preset.background, job.tonemap, job.exposure, job.color_space)
         if defines.get("THICKNESS_MAP"):
             values["u_thickness_map"] = texture_units.THICKNESS_MAP
             assert scene.thickness_map is not None  # the define follows the preset's map

@@ -1,5 +1,6 @@
 """Float64 twin of the display encoding (glsl/lib/display.glsl): tone maps, their
-inverses (for the backdrop a transmitting film lets through), and the sRGB transfer.
+inverses (for the backdrop a transmitting film lets through), the sRGB transfer, and the
+whole encoding into an output colour space (model/color_space.py).
 
 Colours are on the last axis where a tone map mixes channels (``neutral``); the
 per-channel maps broadcast over any shape.
@@ -10,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from opaline.model import color_space
 from opaline.model.microfacet import FloatArray
 
 # Khronos PBR Neutral (KhronosGroup/ToneMapping, PBR_Neutral/README.md): F90 is the
@@ -86,3 +88,10 @@ def srgb_encode(x: npt.ArrayLike) -> FloatArray:
 def srgb_decode(x: npt.ArrayLike) -> FloatArray:
     x = np.clip(x, 0.0, 1.0)
     return np.where(x <= 0.04045, x / 12.92, np.power((x + 0.055) / 1.055, 2.4))
+
+
+def display_encode(linear_srgb: npt.ArrayLike, mode: str, space: str = "srgb") -> FloatArray:
+    """Exposed linear sRGB radiance (colours on the last axis) to display values in
+    ``space``: its primaries, its gamut, the tone map, its transfer curve."""
+    x = np.asarray(linear_srgb, dtype=np.float64) @ color_space.from_srgb(space).T
+    return color_space.encode(tonemap(color_space.gamut_map(x, space), mode), space)

@@ -121,7 +121,8 @@ def grating_spectral(
         s = cast(FloatArray, sum(order_term(material, frame, l, v, m, lam_i)
                                  for m in range(-orders, orders + 1)))
         total = total + s[..., None] * w
-    return np.maximum(total, 0.0)
+    result = cast(FloatArray, total)  # a channel below 0 goes to the display's gamut map
+    return result
 
 
 def channel_wavelengths() -> np.ndarray:
@@ -168,4 +169,5 @@ def grating_fast(material: Material, frame: Frame, l: FloatArray, v: FloatArray)
         [efficiency(0, lam_c, material.grating_depth, kn_pos) for lam_c in channel_wavelengths()],
         axis=-1,
     )
-    return np.maximum(total + zero[..., None] * eta0, 0.0)
+    result: FloatArray = total + zero[..., None] * eta0
+    return result

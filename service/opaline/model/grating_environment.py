@@ -164,6 +164,6 @@ def environment_grating(material: Material, vl: FloatArray, radiance: Radiance,
     total = total + np.sum(weight * scale[..., None] * reads_rgb, axis=-2)
     f = fresnel_schlick(material.f0, nv)
     result: FloatArray = np.where((nv > 0.0)[..., None],
-                                  np.maximum(material.ks * (f * nv)[..., None] * total, 0.0),
+                                  material.ks * (f * nv)[..., None] * total,
                                   0.0)
     return result

@@ -22,6 +22,7 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from opaline.model import messages
+from opaline.model.color_space import ColorSpace
 
 # Re-exported: the material's fields are declared in opaline.model.material.
 from opaline.model.material import MATERIAL_FIELDS as MATERIAL_FIELDS
@@ -128,6 +129,13 @@ class RenderFields(MaterialFields, SceneFields):
     tonemap: Tonemap | None = Field(
         None, description="Tone map before sRGB: 'none' clamps, 'reinhard', 'aces', "
                     "'neutral' (Khronos PBR Neutral: keeps hue)."
+    )
+    color_space: ColorSpace | None = Field(
+        None, description="The image's colour space: 'srgb' (default), or the wider "
+        "'display-p3' or 'rec2020', which keep the films' cyans and the stacks' blues that "
+        "sRGB cannot show. The file says which (an ICC profile; a PNG also cICP). A colour "
+        "outside the space is moved toward the grey of its luminance, hue kept; 'npy' is "
+        "linear in the space, a colour outside it with a channel below 0."
     )
     light_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None,

@@ -107,7 +107,8 @@ def mdf_rgb(
         for theta, weight in zip(thetas, weights, strict=True):
             rx, ry = rotate_half(hx, hy, theta)
             total = total + mdf(material, rx, ry, hz)[..., None] * weight
-        return np.maximum(total, 0.0)
+        # A channel below 0 (outside sRGB) goes to the display's gamut map.
+        return np.asarray(total, dtype=np.float64)
     out = []
     for theta in (0.0, material.theta1, material.theta2):
         rx, ry = rotate_half(hx, hy, theta)

@@ -30,6 +30,7 @@ BASE_DEFAULTS = {
     "quality": "standard",
     "exposure": 1.0,
     "tonemap": "neutral",
+    "color_space": "srgb",
 }
 
 
@@ -67,6 +68,7 @@ class Job:
     environment_samples: int | None = None
     environment_background: bool | None = None
     environment_blur: float | None = None
+    color_space: str = "srgb"
 
     @property
     def quality(self) -> str:

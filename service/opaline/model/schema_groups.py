@@ -18,7 +18,7 @@ GROUPS: list[tuple[str, str, tuple[str, ...]]] = [
     ("coat", "Clear coat", ()),
     ("light", "Light", ("light_azimuth", "light_elevation")),
     ("output", "Output", ("width", "height", "quality", "format", "exposure", "tonemap",
-                          "transparent")),
+                          "color_space", "transparent")),
     ("scene", "Mesh and camera", ("mesh", "tangent_field", "tangent_axis", "camera_azimuth",
                                   "camera_elevation", "camera_distance")),
     ("environment", "Environment", ("environment", "environment_rotation",

@@ -62,10 +62,10 @@ def stack_reflectance(material: Material, cos1: npt.ArrayLike, d_nm: npt.ArrayLi
 
 def stack_rgb(material: Material, cos1: npt.ArrayLike, d_nm: npt.ArrayLike,
               wavelengths: int = 0) -> np.ndarray:
-    """Σ_i w_i·R(λ_i) in linear sRGB, negative sums clamped as the shader clamps them."""
+    """Σ_i w_i·R(λ_i) in linear sRGB; a channel below 0 (outside sRGB) is kept, as the
+    shader keeps it, for the display's gamut map."""
     weights = rgb_weights(stack_bins(wavelengths))
-    rgb: np.ndarray = np.maximum(stack_reflectance(material, cos1, d_nm, wavelengths) @ weights,
-                                 0.0)
+    rgb: np.ndarray = stack_reflectance(material, cos1, d_nm, wavelengths) @ weights
     return rgb
 
 

@@ -118,7 +118,7 @@ def film_rgb_spectral(
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
     r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub)
-    rgb: FloatArray = np.maximum(r @ weights, 0.0)
+    rgb: FloatArray = r @ weights  # a channel below 0 goes to the display's gamut map
     return rgb
 
 
@@ -150,7 +150,8 @@ def film_rgb_fast(
             rgb = rgb + 2.0 * term[..., None] * visible.sensitivity(m * opd_um, m * shift)
         rgb = rgb + 2.0 * amp[..., None] * film_tail(np.abs(x), opd_um, shift)
         total = total + 0.5 * rgb
-    return np.maximum(np.where(tir[..., None], 1.0, total), 0.0)
+    result: FloatArray = np.where(tir[..., None], 1.0, total)
+    return result
 
 
 def film_tail(x_abs: npt.ArrayLike, opd_um: npt.ArrayLike, shift: npt.ArrayLike) -> Values:
@@ -196,7 +197,7 @@ def film_rgb_fast_conductor(
             channel = channel + 2.0 * amp * np.asarray(film_tail(np.abs(x), opd_um, shift))[..., c]
             total = total + 0.5 * channel
         channels.append(np.where(tir, 1.0, total))
-    rgb: FloatArray = np.maximum(np.stack(channels, axis=-1), 0.0)
+    rgb: FloatArray = np.stack(channels, axis=-1)
     return rgb
 
 
@@ -214,7 +215,7 @@ def film_base_rgb(cos1: npt.ArrayLike, n_sub: Substrate, wavelengths: int = 0) -
     bare = np.where(tir, 1.0, 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2))
     if wavelengths > 0:
         bare = bare @ rgb_weights(wavelengths)
-    rgb: FloatArray = np.maximum(bare, 0.0)
+    rgb: FloatArray = bare
     return rgb
 
 

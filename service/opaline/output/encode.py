@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from opaline.output.color_tags import icc_profile, png_chunks
 from opaline.output.formats import LOSSY, encode_pillow
 
 if TYPE_CHECKING:
@@ -38,7 +39,6 @@ EXTENSIONS = {"png": ".png", "png16": ".png", "npy": ".npy", "webp": ".webp",
               "webp-lossless": ".webp", "avif": ".avif", "jpeg": ".jpg"}
 PNG_LEVEL = 1
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
-SRGB = b"\x00"  # sRGB chunk, perceptual intent: the pixels are sRGB-encoded
 
 
 def quantise(display: np.ndarray, bits: int) -> np.ndarray:
@@ -52,22 +52,25 @@ def _chunk(kind: bytes, payload: bytes) -> bytes:
     return struct.pack(">I", len(payload)) + body + struct.pack(">I", zlib.crc32(body))
 
 
-def _png(rows: bytes, width: int, height: int, depth: int, channels: int) -> bytes:
+def _png(rows: bytes, width: int, height: int, depth: int, channels: int,
+         space: str = "srgb") -> bytes:
     colour_type = 6 if channels == 4 else 2
     header = struct.pack(">IIBBBBB", width, height, depth, colour_type, 0, 0, 0)
-    return (SIGNATURE + _chunk(b"IHDR", header) + _chunk(b"sRGB", SRGB)
+    tags = b"".join(_chunk(kind, payload) for kind, payload in png_chunks(space))
+    return (SIGNATURE + _chunk(b"IHDR", header) + tags
             + _chunk(b"IDAT", deflater.compress(rows, PNG_LEVEL)) + _chunk(b"IEND", b""))
 
 
-def png_pixels(pixels: np.ndarray) -> bytes:
-    """8-bit RGB or RGBA (H, W, C) uint8, every row filtered "up" (type 2)."""
+def png_pixels(pixels: np.ndarray, space: str = "srgb") -> bytes:
+    """8-bit RGB or RGBA (H, W, C) uint8, every row filtered "up" (type 2), tagged as
+    ``space``."""
     height, width, channels = pixels.shape
     flat = pixels.reshape(height, width * channels)
     rows = np.empty((height, 1 + width * channels), np.uint8)
     rows[:, 0] = 2
     rows[0, 1:] = flat[0]  # the row above the first is zero
     np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])  # wraps modulo 256, as PNG wants
-    return _png(rows.tobytes(), width, height, 8, channels)
+    return _png(rows.tobytes(), width, height, 8, channels, space)
 
 
 def png8(display: np.ndarray, alpha: bool) -> bytes:
@@ -75,7 +78,7 @@ def png8(display: np.ndarray, alpha: bool) -> bytes:
     return png_pixels(quantise(display[..., :4 if alpha else 3], 8))
 
 
-def png16(display: np.ndarray, alpha: bool) -> bytes:
+def png16(display: np.ndarray, alpha: bool, space: str = "srgb") -> bytes:
     """16 bits per channel (filter type 0), from float display values."""
     channels = 4 if alpha else 3
     data = quantise(display[..., :channels], 16).astype(">u2")
@@ -83,7 +86,7 @@ def png16(display: np.ndarray, alpha: bool) -> bytes:
     rows = np.concatenate(
         [np.zeros((height, 1), np.uint8), data.view(np.uint8).reshape(height, -1)], 1
     )
-    return _png(rows.tobytes(), width, height, 16, channels)
+    return _png(rows.tobytes(), width, height, 16, channels, space)
 
 
 def npy(array: np.ndarray) -> bytes:
@@ -92,20 +95,22 @@ def npy(array: np.ndarray) -> bytes:
     return out.getvalue()
 
 
-def encode_frame(frame: Frame, fmt: str, alpha: bool = False) -> bytes:
+def encode_frame(frame: Frame, fmt: str, alpha: bool = False, space: str = "srgb") -> bytes:
+    """The frame in ``fmt``, its display values (or, for npy, linear values) in ``space``,
+    which the file names."""
     if fmt == "npy":
         assert frame.linear is not None  # the renderer reads linear pixels for npy
         return npy(frame.linear)
     if fmt == "png16":
         assert frame.display is not None  # and display values for 16 bits
-        return png16(frame.display, alpha)
+        return png16(frame.display, alpha, space)
     pixels = getattr(frame, "pixels", None)
     if pixels is None:  # a float frame (the Python API's arrays, tests)
         assert frame.display is not None  # a frame without pixels has display values
         pixels = quantise(frame.display[..., :4 if alpha else 3], 8)
     if fmt == "png":
-        return png_pixels(pixels)
-    return encode_pillow(pixels, fmt)
+        return png_pixels(pixels, space)
+    return encode_pillow(pixels, fmt, icc_profile(space))
 
 
 def mdf_display(plot: np.ndarray) -> np.ndarray:

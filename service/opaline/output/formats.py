@@ -30,13 +30,15 @@ NEGOTIABLE = (("image/webp", "webp"), ("image/avif", "avif"), ("image/png", "png
 DEFAULT = "png"
 
 
-def encode_pillow(pixels: np.ndarray, fmt: str) -> bytes:
+def encode_pillow(pixels: np.ndarray, fmt: str, icc: bytes | None = None) -> bytes:
+    """``pixels`` in ``fmt``, with the ICC profile ``icc`` of their colour space (none:
+    sRGB, each format's default)."""
     from PIL import Image  # only these formats need Pillow: the PNG path stays light
 
     name, options = SETTINGS[fmt]
     image = Image.fromarray(np.ascontiguousarray(pixels), "RGBA" if pixels.shape[2] == 4 else "RGB")
     out = io.BytesIO()
-    image.save(out, format=name, **options)
+    image.save(out, format=name, **options, **({"icc_profile": icc} if icc else {}))
     return out.getvalue()
 
 

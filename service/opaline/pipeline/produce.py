@@ -26,4 +26,4 @@ def produce(prepared: Prepared, renderer: FrameRenderer,
             should_stop: StopCheck | None = None) -> bytes:
     job = prepared.job
     frame = renderer.render(job, prepared.preset, should_stop=should_stop)
-    return encode_frame(frame, job.format, alpha=job.transparent)
+    return encode_frame(frame, job.format, alpha=job.transparent, space=job.color_space)

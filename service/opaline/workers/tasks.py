@@ -73,7 +73,8 @@ class ImageTask:
                                 or k in ("grating_orders", "film_stack_pairs")))
         material += (("coat", job.material.coat_weight > 0.0),)  # COAT's define
         return (self.prepared.preset.name, self.prepared.preset.geometry.args.get("path"),
-                job.wavelengths, job.samples, job.aa, job.tonemap, job.transparent,
+                job.wavelengths, job.samples, job.aa, job.tonemap, job.color_space,
+                job.transparent,
                 job.environment, job.environment_lights, job.environment_samples,
                 job.environment_background, material)
 
