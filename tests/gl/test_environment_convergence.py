@@ -23,6 +23,7 @@ from opaline.model import reference as ref
 from opaline.model.params import Material
 from opaline.scene.bright import split_bright
 from opaline.scene.environments import resolve_map
+from radiance_checks import is_radiance, radiance_problems
 
 pytestmark = pytest.mark.gl
 
@@ -107,7 +108,7 @@ def test_brute_force_estimate_converges_to_the_quadrature(renderer, radiance, na
     environment = (uploaded.texture, uploaded.irradiance)
     passes = renderer.probes.lobe(mat, "specular", (N, T, V), environment, rotation=rotation,
                                   samples=SAMPLES, passes=PASSES)[..., :3].astype(np.float64)
-    assert np.isfinite(passes).all() and (passes >= 0).all()
+    assert is_radiance(passes), radiance_problems(passes)
     estimate = passes.mean(0)
     error = passes.std(0, ddof=1) / math.sqrt(PASSES)
     expected = np.array([quadrature(mat, radiance, n, t, v, rotation)

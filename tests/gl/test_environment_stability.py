@@ -19,6 +19,7 @@ from environment_cases import BRIGHT_TEXEL, ENVIRONMENT_MAPS, write_environment
 from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.model.request import resolve
+from radiance_checks import is_radiance, radiance_problems
 from stability_cases import EXTREMES
 
 pytestmark = pytest.mark.gl
@@ -61,7 +62,7 @@ def render(renderer, environment: str, tier: str, fmt: str = "npy", **fields):
 def assert_finite(image: np.ndarray, what: str) -> None:
     bad = ~np.isfinite(image)
     assert not bad.any(), f"{what}: {int(bad.sum())} non-finite values at {np.argwhere(bad)[:3]}"
-    assert (image >= 0).all(), f"{what}: negative values, min {image.min()}"
+    assert is_radiance(image), f"{what}: {radiance_problems(image)}"
 
 
 @pytest.mark.parametrize("tier", TIERS)

@@ -13,6 +13,7 @@ from PIL import Image
 from opaline.model.params import RenderRequest
 from opaline.model.presets import all_presets, get_preset
 from opaline.model.request import resolve
+from radiance_checks import is_radiance, radiance_problems
 
 pytestmark = pytest.mark.gl
 PRESETS = sorted(all_presets())
@@ -28,7 +29,7 @@ def test_every_preset_renders_a_finite_nonnegative_object(renderer, name):
     frame = renderer.render(job_for(name, width=128, height=128, format="npy", quality="draft"))
     image = frame.linear
     assert image.shape == (128, 128, 4) and image.dtype == np.float32
-    assert np.isfinite(image).all() and (image >= 0).all()
+    assert is_radiance(image), radiance_problems(image)
     coverage = image[..., 3]
     assert 0.1 < coverage.mean() <= 1.0
     lit = image[..., :3][coverage > 0.5]
