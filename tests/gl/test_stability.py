@@ -6,7 +6,8 @@ the extreme: ``ex=1e6``, ``theta1=-2pi``, ``mu_f=0`` ...):
 1. the MDF plot (GLSL) agrees with the float64 reference within 1e-4 of the
    plot's peak (1e-6 absolute where the peak is ~0);
 2. the BRDF probe on random, lobe-aimed and degenerate (n, t, l, v) cases is
-   finite, of luminance ≥ 0 (a channel may go below 0 outside sRGB) and within |gl - ref| <= 2e-3·(|ref| + 1e-3·max|ref|);
+   finite, of luminance ≥ 0 (a channel may go below 0 outside sRGB) and within
+   |gl - ref| <= 2e-3·(|ref| + 1e-3·max|ref|);
 3. a float render of a preset with that material is finite and of luminance ≥ 0.
 
 Then hypothesis draws materials over the full ranges; the degenerate geometry of
