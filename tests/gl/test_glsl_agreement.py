@@ -136,18 +136,18 @@ def test_no_specular_when_light_is_opposite_view(renderer):
 def test_display_encoding_matches_reference(renderer, tonemap, space):
     """The resolve's exposure, output primaries, gamut map, tone map and transfer curve agree
     with the float64 twin (model/display.py) on the renderer's own linear radiance, over
-    pixels below and above neutral's knee and pixels outside sRGB (the CD's spectral
-    colours)."""
+    pixels below and above neutral's knee and pixels outside sRGB (the oil slick's
+    spectral bands)."""
     from dataclasses import replace
 
     from opaline.model.display import KS, display_encode
     from opaline.model.presets import get_preset
     from opaline.model.request import resolve
 
-    exposure = 20.0  # cd-rom peaks at 0.03 … 0.2: this spans the knee at KS = 0.76
-    job = resolve(RenderRequest(preset="cd-rom", width=64, height=64, quality="draft",
+    exposure = 20.0  # oil-slick's radiance spans neutral's knee at KS = 0.76 at this exposure
+    job = resolve(RenderRequest(preset="oil-slick", width=64, height=64, quality="draft",
                                 transparent=True, tonemap=tonemap, exposure=exposure,
-                                format="npy"), get_preset("cd-rom"))
+                                format="npy"), get_preset("oil-slick"))
     linear = renderer.render(job).linear.astype(np.float64)
     display = renderer.render(replace(job, format="png16", color_space=space)).display
     coverage = linear[..., 3]
@@ -159,3 +159,22 @@ def test_display_encoding_matches_reference(renderer, tonemap, space):
     expected = display_encode(straight, tonemap, space)
     assert np.abs(display[covered, :3] - expected).max() < 1e-4
     assert np.allclose(display[..., 3], np.clip(coverage, 0.0, 1.0), atol=1e-6)
+
+
+@pytest.mark.parametrize("space", ["srgb", "display-p3", "rec2020"])
+@pytest.mark.parametrize("fmt", ["png", "png16"])
+def test_the_background_is_the_same_colour_in_every_space(renderer, space, fmt):
+    """The preset's background (display sRGB) is drawn as the same colour's display values
+    in the output's space, by the one-sample direct draw (png, draft) and the resolve."""
+    from opaline.model import color_space
+    from opaline.model.presets import get_preset
+    from opaline.model.request import resolve
+
+    preset = get_preset("bragg-mirror")
+    job = resolve(RenderRequest(preset="bragg-mirror", width=32, height=32, quality="draft",
+                                samples=1, format=fmt, color_space=space, environment="none"),
+                  preset)
+    frame = renderer.render(job, preset)
+    corner = (frame.pixels[0, 0, :3] / 255.0 if fmt == "png" else frame.display[0, 0, :3])
+    want = color_space.display_background(preset.background, space)
+    np.testing.assert_allclose(corner, want, atol=0.6 / 255.0 if fmt == "png" else 1e-4)

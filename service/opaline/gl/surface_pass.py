@@ -29,6 +29,7 @@ from opaline.gl.buffers import Cancelled, SceneGPU, Targets
 from opaline.gl.lighting import light_uniforms
 from opaline.gl.resolve import display_defines, display_uniforms
 from opaline.gl.resources import Resources
+from opaline.model import color_space
 from opaline.model.camera import fit_matrix, model_matrix, view_camera, view_projection
 from opaline.model.environment_light import reads_map
 from opaline.model.presets import Preset
@@ -59,7 +60,10 @@ class DrawPlan:
         """A direct draw clears to what the resolve composes over: the background (opaque)
         or nothing (transparent); linear samples clear to nothing, their alpha coverage."""
         opaque = self.display and not job.transparent
-        return (*(preset.background if opaque else (0.0, 0.0, 0.0)), float(opaque))
+        if not opaque:
+            return (0.0, 0.0, 0.0, 0.0)
+        shown = color_space.display_background(preset.background, job.color_space)
+        return (*(float(v) for v in shown), 1.0)
 
 
 @dataclass(frozen=True)
