@@ -10,6 +10,13 @@
 #define PI 3.14159265358979323846
 #define TWO_PI 6.28318530717958647692
 #define EPS_DENOM 1e-4
+
+// A colour of luminance at or below 0 is no radiance (a fast path's fit ringing, an
+// estimator's negative pass): black. A channel below 0 under a luminance above 0 is a
+// colour outside sRGB, kept for the display's gamut map. Twin: model/color_space.py.
+vec3 radiance_floor(vec3 c) {
+    return dot(c, vec3(0.2126, 0.7152, 0.0722)) > 0.0 ? c : vec3(0.0);
+}
 #define EPS_HALF 1e-6
 
 #ifdef PRECISE_PHASE

@@ -143,7 +143,7 @@ vec3 environment_grating(Material mat, Environment env, realmat3 frame, vec3 v) 
             sum += w / max(l.z, vl.z) * grating_read(env, frame, l, vl.z, lobe_h, 2.0 * half_b);
         }
     }
-    return mat.ks * material_fresnel(mat, vl.z) * vl.z * sum;
+    return radiance_floor(mat.ks * material_fresnel(mat, vl.z) * vl.z * sum);
 }
 
 #endif

@@ -222,7 +222,7 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
 #endif
 #ifdef ENV_ENVELOPE
     // Each wavelength once a pass: the sum is the pass's estimate of the bands.
-    return sum + specular_envelope(mat, env, vec3(frame[2]), v);
+    return radiance_floor(sum + specular_envelope(mat, env, vec3(frame[2]), v));
 #else
     return sum / float(ENV_SAMPLES);
 #endif

@@ -106,7 +106,7 @@ vec3 grating_color_spectral(Material mat, vec3 k, vec3 vl, float cos_max) {
 #endif
         sum += u_spectral_weight[i] * s;
     }
-    return sum;
+    return radiance_floor(sum);
 }
 #endif
 
@@ -167,7 +167,7 @@ vec3 grating_color_visible(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 eta0 = vec3(grating_efficiency(0, mat.grating.channel_nm.r, k.z, depth),
                      grating_efficiency(0, mat.grating.channel_nm.g, k.z, depth),
                      grating_efficiency(0, mat.grating.channel_nm.b, k.z, depth));
-    return sum + zero * eta0;
+    return radiance_floor(sum + zero * eta0);
 }
 #endif
 

@@ -98,7 +98,7 @@ vec3 mdf_color(Material mat, real2 h, float hz) {
         sum += u_spectral_weight[i] * mdf(mat, rotate_half(h, u_spectral_rotation[i]), hz);
     }
     // A channel below 0 (a colour outside sRGB) is kept to the display's gamut map.
-    return sum;
+    return radiance_floor(sum);
 }
 #else
 vec3 mdf_color(Material mat, real2 h, float hz) {

@@ -91,7 +91,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
         float r = 0.5 * (film_airy(r12.x, r23.x, c) + film_airy(r12.y, r23.y, c));
         sum += u_spectral_weight[i] * r;
     }
-    return sum;  // a channel below 0 is kept to the display's gamut map
+    return radiance_floor(sum);  // a channel below 0 is kept to the display's gamut map
 }
 #else
 // Fast path (Belcour & Barla 2017): R(φ) = c0 + 2·Σ_m c_m cos(mφ) with
@@ -146,7 +146,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
         }
         rgb += u_film_sens_weight[k] * (terms + d16 * tail);
     }
-    return rgb;
+    return radiance_floor(rgb);
 }
 #endif  // WAVELENGTHS
 #endif  // SUBSTRATE_CONDUCTOR

@@ -60,7 +60,7 @@ vec3 film_base_rgb(Film film, float cos1) {
     for (int i = 0; i < WAVELENGTHS; ++i) {
         sum += u_spectral_weight[i] * film_bare_conductor(cos1, u_substrate_nk[i]);
     }
-    return sum;
+    return radiance_floor(sum);
 }
 
 #ifndef STACK_PAIRS  // a stack's layers draw the film instead (lib/thin_film_stack.glsl)
@@ -81,7 +81,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
         float r = 0.5 * (film_airy_complex(r12.x, r23.xy, e) + film_airy_complex(r12.y, r23.zw, e));
         sum += u_spectral_weight[i] * r;
     }
-    return sum;
+    return radiance_floor(sum);
 }
 #endif
 #else
@@ -141,7 +141,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
     vec3 rgb = vec3(film_channel(0, film.ior, cos1, cos2, r12, opd_um),
                     film_channel(1, film.ior, cos1, cos2, r12, opd_um),
                     film_channel(2, film.ior, cos1, cos2, r12, opd_um));
-    return rgb;
+    return radiance_floor(rgb);
 }
 #endif
 #endif

@@ -89,7 +89,7 @@ vec3 film_rgb(Film film, float cos1, float d) {
         vec2 el = c_exp_i(TWO_PI * fract(opd_l / stack_bin_nm(i)));
         sum += stack_bin_weight(i) * stack_reflectance(bottom, r_top, r_lh, eh, el);
     }
-    return sum;
+    return radiance_floor(sum);
 }
 
 #endif

@@ -62,8 +62,9 @@ class DrawPlan:
         opaque = self.display and not job.transparent
         if not opaque:
             return (0.0, 0.0, 0.0, 0.0)
-        shown = color_space.display_background(preset.background, job.color_space)
-        return (*(float(v) for v in shown), 1.0)
+        red, green, blue = (float(v) for v in
+                            color_space.display_background(preset.background, job.color_space))
+        return (red, green, blue, 1.0)
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ PRIMARIES: dict[str, tuple[tuple[float, float], ...]] = {
 # and its cICP code (transfer 1) say.
 BT709_ALPHA = 1.09929682680944
 BT709_BETA = 0.018053968510807
+SRGB_LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # Y of linear sRGB, as the shader weighs it
 
 
 def _xyz(xy: tuple[float, float]) -> FloatArray:
@@ -91,6 +92,15 @@ def decode(v: npt.ArrayLike, space: str) -> FloatArray:
         return np.where(v < knee, v / 4.5,
                         np.power((v + BT709_ALPHA - 1.0) / BT709_ALPHA, 1.0 / 0.45))
     return np.where(v <= 0.04045, v / 12.92, np.power((v + 0.055) / 1.055, 2.4))
+
+
+def radiance_floor(rgb: npt.ArrayLike) -> FloatArray:
+    """Black where a colour's sRGB luminance is not above 0 (glsl/lib/common.glsl): a fit's
+    ringing or an estimator's negative pass is no radiance; a channel below 0 under a
+    luminance above 0 is a colour outside sRGB, kept."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    out: FloatArray = np.where((rgb @ SRGB_LUMINANCE > 0.0)[..., None], rgb, 0.0)
+    return out
 
 
 def display_background(background: npt.ArrayLike, space: str) -> FloatArray:

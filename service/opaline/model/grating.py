@@ -27,6 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from opaline.model import visible
+from opaline.model.color_space import radiance_floor
 from opaline.model.microfacet import (
     EPS_DENOM,
     FloatArray,
@@ -121,7 +122,7 @@ def grating_spectral(
         s = cast(FloatArray, sum(order_term(material, frame, l, v, m, lam_i)
                                  for m in range(-orders, orders + 1)))
         total = total + s[..., None] * w
-    result = cast(FloatArray, total)  # a channel below 0 goes to the display's gamut map
+    result = radiance_floor(total)  # a channel below 0 goes to the display's gamut map
     return result
 
 
@@ -169,5 +170,5 @@ def grating_fast(material: Material, frame: Frame, l: FloatArray, v: FloatArray)
         [efficiency(0, lam_c, material.grating_depth, kn_pos) for lam_c in channel_wavelengths()],
         axis=-1,
     )
-    result: FloatArray = total + zero[..., None] * eta0
+    result = radiance_floor(total + zero[..., None] * eta0)
     return result

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from opaline.model import visible
+from opaline.model.color_space import radiance_floor
 from opaline.model.grating import channel_wavelengths, efficiency
 from opaline.model.microfacet import EPS_DENOM, FloatArray, fresnel_schlick
 from opaline.model.spectrum import RANGE_NM
@@ -164,6 +165,6 @@ def environment_grating(material: Material, vl: FloatArray, radiance: Radiance,
     total = total + np.sum(weight * scale[..., None] * reads_rgb, axis=-2)
     f = fresnel_schlick(material.f0, nv)
     result: FloatArray = np.where((nv > 0.0)[..., None],
-                                  material.ks * (f * nv)[..., None] * total,
+                                  radiance_floor(material.ks * (f * nv)[..., None] * total),
                                   0.0)
     return result

@@ -14,8 +14,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-# Re-exported (as X as X, for the type checker): the reference in one place.
 from opaline.model import coat
+
+# Re-exported (as X as X, for the type checker): the reference in one place.
+from opaline.model.color_space import radiance_floor
 from opaline.model.display import srgb_decode as srgb_decode
 from opaline.model.display import srgb_encode as srgb_encode
 from opaline.model.display import tonemap as tonemap
@@ -108,7 +110,7 @@ def mdf_rgb(
             rx, ry = rotate_half(hx, hy, theta)
             total = total + mdf(material, rx, ry, hz)[..., None] * weight
         # A channel below 0 (outside sRGB) goes to the display's gamut map.
-        return np.asarray(total, dtype=np.float64)
+        return radiance_floor(total)
     out = []
     for theta in (0.0, material.theta1, material.theta2):
         rx, ry = rotate_half(hx, hy, theta)

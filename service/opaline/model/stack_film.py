@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from opaline.model import metals, thinfilm
+from opaline.model.color_space import radiance_floor
 from opaline.model.multilayer import stack_optics
 from opaline.model.spectrum import rgb_weights, sample_wavelengths
 
@@ -65,7 +66,8 @@ def stack_rgb(material: Material, cos1: npt.ArrayLike, d_nm: npt.ArrayLike,
     """Σ_i w_i·R(λ_i) in linear sRGB; a channel below 0 (outside sRGB) is kept, as the
     shader keeps it, for the display's gamut map."""
     weights = rgb_weights(stack_bins(wavelengths))
-    rgb: np.ndarray = stack_reflectance(material, cos1, d_nm, wavelengths) @ weights
+    rgb: np.ndarray = radiance_floor(stack_reflectance(material, cos1, d_nm, wavelengths)
+                                     @ weights)
     return rgb
 
 

@@ -28,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from opaline.model import visible
+from opaline.model.color_space import radiance_floor
 from opaline.model.microfacet import FloatArray, Values
 from opaline.model.spectrum import rgb_weights, sample_wavelengths
 
@@ -118,7 +119,7 @@ def film_rgb_spectral(
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
     r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub)
-    rgb: FloatArray = r @ weights  # a channel below 0 goes to the display's gamut map
+    rgb: FloatArray = radiance_floor(r @ weights)  # a channel below 0: the display's map
     return rgb
 
 
@@ -150,8 +151,7 @@ def film_rgb_fast(
             rgb = rgb + 2.0 * term[..., None] * visible.sensitivity(m * opd_um, m * shift)
         rgb = rgb + 2.0 * amp[..., None] * film_tail(np.abs(x), opd_um, shift)
         total = total + 0.5 * rgb
-    result: FloatArray = np.where(tir[..., None], 1.0, total)
-    return result
+    return radiance_floor(np.where(tir[..., None], 1.0, total))
 
 
 def film_tail(x_abs: npt.ArrayLike, opd_um: npt.ArrayLike, shift: npt.ArrayLike) -> Values:
@@ -197,7 +197,7 @@ def film_rgb_fast_conductor(
             channel = channel + 2.0 * amp * np.asarray(film_tail(np.abs(x), opd_um, shift))[..., c]
             total = total + 0.5 * channel
         channels.append(np.where(tir, 1.0, total))
-    rgb: FloatArray = np.stack(channels, axis=-1)
+    rgb: FloatArray = radiance_floor(np.stack(channels, axis=-1))
     return rgb
 
 
@@ -215,8 +215,7 @@ def film_base_rgb(cos1: npt.ArrayLike, n_sub: Substrate, wavelengths: int = 0) -
     bare = np.where(tir, 1.0, 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2))
     if wavelengths > 0:
         bare = bare @ rgb_weights(wavelengths)
-    rgb: FloatArray = bare
-    return rgb
+    return radiance_floor(bare)
 
 
 def film_layer_rgb(
