@@ -13,7 +13,7 @@ colours with C*ab > 5) and the chroma kept (C*ab shown over exact):
 - ``clip``: each linear sRGB channel below 0 set to 0, as the shader does at each
   spectral sum (glsl/lib/material.glsl, thin_film*.glsl, grating.glsl);
 - ``desaturate``: the colour moved toward the grey of its own luminance until no channel
-  is below 0 (luminance kept);
+  is below 0 (luminance kept): the display's gamut map, ``model/color_space.gamut_map``;
 - ``P3 clip``, ``Rec.2020 clip``: the same per-channel clip in the wider primaries, what
   a Display P3 or Rec. 2020 output would show.
 
@@ -28,6 +28,7 @@ import argparse
 import numpy as np
 
 import white_point as wp
+from opaline.model import color_space
 from opaline.model.multilayer import stack_optics
 from report import save  # bench/report.py: run from bench/, it is on the path
 
@@ -63,22 +64,11 @@ def to_xyz(rgb: np.ndarray, space: str) -> np.ndarray:
                                         apply_cctf_decoding=False))
 
 
-def desaturate(rgb: np.ndarray, space: str) -> np.ndarray:
-    """Toward the grey of the colour's own luminance until no channel is below 0."""
-    import colour
-
-    weights = np.asarray(colour.RGB_COLOURSPACES[SPACES[space]].matrix_RGB_to_XYZ)[1]
-    luma = (rgb @ weights)[..., None]
-    low = rgb.min(axis=-1, keepdims=True)
-    keep = np.where(low < 0.0, np.clip(luma / np.maximum(luma - low, 1e-12), 0.0, 1.0), 1.0)
-    return np.maximum(luma + keep * (rgb - luma), 0.0)
-
-
 def shown(xyz: np.ndarray) -> dict[str, np.ndarray]:
     """XYZ each way of handling shows for the exact ``xyz``."""
     srgb = to_rgb(xyz, "sRGB")
     return {"clip": to_xyz(np.maximum(srgb, 0.0), "sRGB"),
-            "desaturate": to_xyz(desaturate(srgb, "sRGB"), "sRGB"),
+            "desaturate": to_xyz(color_space.gamut_map(srgb, "srgb"), "sRGB"),
             "P3 clip": to_xyz(np.maximum(to_rgb(xyz, "Display P3"), 0.0), "Display P3"),
             "Rec.2020 clip": to_xyz(np.maximum(to_rgb(xyz, "Rec. 2020"), 0.0), "Rec. 2020")}
 
