@@ -13,8 +13,8 @@ uniform vec3 u_spectral_weight[WAVELENGTHS];
 uniform float u_wavelength_nm[WAVELENGTHS];
 #endif
 #if WAVELENGTHS == 0 && defined(IRIDESCENCE_THIN_FILM)
-// The fast path's Gaussians per channel (opaline/model/visible.py SENSITIVITY_GAUSSIANS).
-#define FILM_GAUSSIANS 4
+// The fast path's Gaussians per channel: FILM_GAUSSIANS, defined by
+// gl/material_program.py from opaline/model/visible.py's SENSITIVITY_GAUSSIANS.
 uniform vec3 u_film_sens_weight[FILM_GAUSSIANS];
 uniform vec3 u_film_sens_centre[FILM_GAUSSIANS];
 uniform vec3 u_film_sens_sigma[FILM_GAUSSIANS];

@@ -84,6 +84,8 @@ def material_defines(material: Material, wavelengths: int = 0, aa: str = "none")
         defines["FILM_WEIGHT"] = True
     if stack_film.is_stack(material):
         defines["STACK_PAIRS"] = material.film_stack_pairs
+    if material.iridescence == "thin-film" and wavelengths == 0:  # the film's fast path
+        defines["FILM_GAUSSIANS"] = visible.SENSITIVITY_GAUSSIANS
     if coat.has_coat(material):
         defines["COAT"] = True
     return defines
