@@ -32,21 +32,31 @@ float film_ratio(float num, float den) {
     return num / (abs(den) > 1e-30 ? den : 1e-30);
 }
 
+// cos²θ in a layer of index n lit from air at cos θ1 (Snell): 1 - sin²θ1/n² as
+// (n² - 1 + cos²θ1)/n², since near grazing 1 - cos²θ1 rounds to 1 in float, which would
+// turn a film of index 1 into total reflection. Below 0: no light gets through.
+float layer_cos_sq(float n, float cos1) {
+    return (n * n - 1.0 + cos1 * cos1) / (n * n);
+}
+
+// The Fresnel amplitude at the interface from a medium (na, cos_a) above into (nb, cos_b)
+// below, for s (.x) and p (.y).
+vec2 interface_amplitude(float na, float cos_a, float nb, float cos_b) {
+    return vec2(film_ratio(na * cos_a - nb * cos_b, na * cos_a + nb * cos_b),
+                film_ratio(nb * cos_a - na * cos_b, nb * cos_a + na * cos_b));
+}
+
 // Both interfaces for s (.x) and p (.y); false where light cannot get through.
 bool film_interfaces(Film film, float cos1, out float cos2, out vec2 r12, out vec2 r23) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float nf = film.ior;
     float ns = film.substrate_ior;
-    // cos²θ2 = 1 - sin²θ1/n² as (n² - 1 + cos²θ1)/n²: near grazing 1 - cos²θ1 rounds
-    // to 1 in float, which would turn a film of index 1 into total reflection.
-    float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
-    float cos3_sq = (ns * ns - 1.0 + cos1 * cos1) / (ns * ns);
+    float cos2_sq = layer_cos_sq(nf, cos1);
+    float cos3_sq = layer_cos_sq(ns, cos1);
     cos2 = sqrt(max(cos2_sq, 0.0));
     float cos3 = sqrt(max(cos3_sq, 0.0));
-    r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
-               film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
-    r23 = vec2(film_ratio(nf * cos2 - ns * cos3, nf * cos2 + ns * cos3),
-               film_ratio(ns * cos2 - nf * cos3, ns * cos2 + nf * cos3));
+    r12 = interface_amplitude(1.0, cos1, nf, cos2);
+    r23 = interface_amplitude(nf, cos2, ns, cos3);
     return cos2_sq > 0.0 && cos3_sq > 0.0;
 }
 
@@ -59,10 +69,8 @@ bool film_interfaces(Film film, float cos1, out float cos2, out vec2 r12, out ve
 vec3 film_base_rgb(Film film, float cos1) {
     cos1 = clamp(cos1, 0.0, 1.0);
     float ns = film.substrate_ior;
-    float cos3_sq = (ns * ns - 1.0 + cos1 * cos1) / (ns * ns);
-    float cos3 = sqrt(max(cos3_sq, 0.0));
-    vec2 r = vec2(film_ratio(cos1 - ns * cos3, cos1 + ns * cos3),
-                  film_ratio(ns * cos1 - cos3, ns * cos1 + cos3));
+    float cos3_sq = layer_cos_sq(ns, cos1);
+    vec2 r = interface_amplitude(1.0, cos1, ns, sqrt(max(cos3_sq, 0.0)));
     return vec3(cos1 > 0.0 && cos3_sq > 0.0 ? 0.5 * dot(r, r) : 1.0);
 }
 

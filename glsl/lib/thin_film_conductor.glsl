@@ -14,10 +14,9 @@
 // The film's top interface (s, p), as film_interfaces; false where light cannot enter,
 // and exactly at grazing, where all is reflected (over a lossless ñ = 1 Airy is 0/0).
 bool film_top(float nf, float cos1, out float cos2, out vec2 r12) {
-    float cos2_sq = (nf * nf - 1.0 + cos1 * cos1) / (nf * nf);
+    float cos2_sq = layer_cos_sq(nf, cos1);
     cos2 = sqrt(max(cos2_sq, 0.0));
-    r12 = vec2(film_ratio(cos1 - nf * cos2, cos1 + nf * cos2),
-               film_ratio(nf * cos1 - cos2, nf * cos1 + cos2));
+    r12 = interface_amplitude(1.0, cos1, nf, cos2);
     return cos2_sq > 0.0 && cos1 > 0.0;
 }
 

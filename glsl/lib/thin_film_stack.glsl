@@ -10,7 +10,8 @@
 // conductor below makes the first r complex. Per wavelength and polarisation, averaged
 // over s and p and integrated with the spectral path's colour weights; the fast path has
 // no closed form for a stack and integrates STACK_BINS bins of its own.
-// Included by lib/thin_film.glsl, which provides film_base_rgb and film_ratio.
+// Included by lib/thin_film.glsl, which provides film_base_rgb, layer_cos_sq and
+// interface_amplitude.
 #ifndef THIN_FILM_STACK_GLSL
 #define THIN_FILM_STACK_GLSL
 #include "lib/complex.glsl"
@@ -29,14 +30,7 @@
 
 // cos θ in a lossless layer of index n ≥ 1, lit from air at cos θ1 (never total reflection).
 float stack_cos(float n, float cos1) {
-    return sqrt(max((n * n - 1.0 + cos1 * cos1) / (n * n), 0.0));
-}
-
-// The amplitude at the interface from a medium (na, cos_a) above into (nb, cos_b) below,
-// for s (.x) and p (.y), as film_interfaces writes its r12 and r23.
-vec2 stack_interface(float na, float cos_a, float nb, float cos_b) {
-    return vec2(film_ratio(na * cos_a - nb * cos_b, na * cos_a + nb * cos_b),
-                film_ratio(nb * cos_a - na * cos_b, nb * cos_a + na * cos_b));
+    return sqrt(max(layer_cos_sq(n, cos1), 0.0));
 }
 
 // One layer laid over the amplitude r of what lies below it; e = e^{iφ} its round trip.
@@ -69,14 +63,14 @@ vec3 film_rgb(Film film, float cos1, float d) {
     float nl = film.spacer_ior;
     float cos_h = stack_cos(nh, cos1);
     float cos_l = stack_cos(nl, cos1);
-    vec2 r_top = stack_interface(1.0, cos1, nh, cos_h);
-    vec2 r_lh = stack_interface(nl, cos_l, nh, cos_h);  // a spacer above a film layer
+    vec2 r_top = interface_amplitude(1.0, cos1, nh, cos_h);
+    vec2 r_lh = interface_amplitude(nl, cos_l, nh, cos_h);  // a spacer above a film layer
     float spacer = film.thickness_max > 0.0 ? film.spacer_nm * d / film.thickness_max
                                             : film.spacer_nm;
     float opd_h = 2.0 * nh * d * cos_h;  // nm
     float opd_l = 2.0 * nl * spacer * cos_l;
 #ifndef SUBSTRATE_CONDUCTOR
-    vec2 r_sub = stack_interface(nl, cos_l, film.substrate_ior, stack_cos(film.substrate_ior, cos1));
+    vec2 r_sub = interface_amplitude(nl, cos_l, film.substrate_ior, stack_cos(film.substrate_ior, cos1));
     vec4 bottom = vec4(r_sub.x, 0.0, r_sub.y, 0.0);
 #endif
     vec3 sum = vec3(0.0);
