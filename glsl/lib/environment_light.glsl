@@ -129,9 +129,11 @@ vec4 env_sample_half(Material mat, Environment env, vec3 u) {
     vec4 s = sample_ashikhmin(u.xy, mat.ex, mat.ey);
     vec2 cs = env.lobe_rotation[c];
     vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
+    float log_scale = ashikhmin_log_scale(h.xy);
     for (int i = 0; i < 3; ++i) {
-        g_env_lobes[i] = mdf_ashikhmin(rotate_half(h.xy, env.lobe_rotation[i]), h.z, mat.ex, mat.ey);
+        g_env_lobes[i] = ashikhmin_turned(h.xy, env.lobe_rotation[i], log_scale, mat.ex, mat.ey);
     }
+    g_env_lobes *= h.z > 0.0 ? ashikhmin_norm(mat.ex, mat.ey) : 0.0;
     return vec4(h, (g_env_lobes.x + g_env_lobes.y + g_env_lobes.z) / 3.0);
 #endif
 }

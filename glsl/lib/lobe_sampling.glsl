@@ -22,16 +22,15 @@ vec4 sample_ashikhmin(vec2 u, float ex, float ey) {
     float q = min(u.x * 4.0, 3.99999);
     float quadrant = floor(q);
     float f = q - quadrant;
-    float phi = atan(sqrt((ex + 1.0) / (ey + 1.0)) * tan(0.5 * PI * f));
-    if (quadrant == 1.0) {
-        phi = PI - phi;
-    } else if (quadrant == 2.0) {
-        phi = PI + phi;
-    } else if (quadrant == 3.0) {
-        phi = TWO_PI - phi;
-    }
-    float c = cos(phi);
-    float s = sin(phi);
+    // φ = atan(k·tan a), a = ½π·f, k = √((ex + 1)/(ey + 1)), as their paper writes it; its
+    // cosine and sine are (cos a, k·sin a) normalised, which spares a sample atan's, tan's
+    // and φ's own cosine and sine (the twin keeps the paper's form).
+    float a = 0.5 * PI * f;
+    vec2 cs = vec2(cos(a), sqrt((ex + 1.0) / (ey + 1.0)) * sin(a));
+    cs *= inversesqrt(dot(cs, cs));
+    // Into quadrant 1 as π − φ, 2 as π + φ, 3 as 2π − φ.
+    float c = quadrant == 1.0 || quadrant == 2.0 ? -cs.x : cs.x;
+    float s = quadrant >= 2.0 ? -cs.y : cs.y;
     float e = ex * c * c + ey * s * s;
     float t = log(max(1.0 - u.y, 1e-30)) / (e + 1.0);
     float one_minus_hz = one_minus_exp(t);

@@ -90,15 +90,34 @@ float mdf(Material mat, real2 h, float hz) {
 }
 #endif
 
-#if WAVELENGTHS > 0
-// CIE 1931 CMFs × XYZ→sRGB, white balanced so equal D gives equal RGB.
+#if WAVELENGTHS > 0 && defined(MDF_ASHIKHMIN)
+// CIE 1931 CMFs × XYZ→sRGB, white balanced so equal D gives equal RGB; eq. 1's logarithm
+// once for every wavelength (a turn keeps |h|), its exp at each.
+vec3 mdf_color(Material mat, real2 h, float hz) {
+    float log_scale = ashikhmin_log_scale(h);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < WAVELENGTHS; ++i) {
+        sum += u_spectral_weight[i] * ashikhmin_turned(h, u_spectral_rotation[i], log_scale,
+                                                       mat.ex, mat.ey);
+    }
+    // A channel below 0 (a colour outside sRGB) is kept to the display's gamut map.
+    return hz > 0.0 ? radiance_floor(ashikhmin_norm(mat.ex, mat.ey) * sum) : vec3(0.0);
+}
+#elif WAVELENGTHS > 0
 vec3 mdf_color(Material mat, real2 h, float hz) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < WAVELENGTHS; ++i) {
         sum += u_spectral_weight[i] * mdf(mat, rotate_half(h, u_spectral_rotation[i]), hz);
     }
-    // A channel below 0 (a colour outside sRGB) is kept to the display's gamut map.
     return radiance_floor(sum);
+}
+#elif defined(MDF_ASHIKHMIN)
+vec3 mdf_color(Material mat, real2 h, float hz) {
+    float log_scale = ashikhmin_log_scale(h);
+    vec3 d = vec3(ashikhmin_turned(h, mat.rotation[0], log_scale, mat.ex, mat.ey),
+                  ashikhmin_turned(h, mat.rotation[1], log_scale, mat.ex, mat.ey),
+                  ashikhmin_turned(h, mat.rotation[2], log_scale, mat.ex, mat.ey));
+    return hz > 0.0 ? ashikhmin_norm(mat.ex, mat.ey) * d : vec3(0.0);
 }
 #else
 vec3 mdf_color(Material mat, real2 h, float hz) {

@@ -4,6 +4,7 @@
 #ifndef MDF_ASHIKHMIN_GLSL
 #define MDF_ASHIKHMIN_GLSL
 #include "lib/common.glsl"
+#include "lib/rotation.glsl"
 
 // -log1p(-s2)/s2: 1 at the pole, growing toward the rim. GLSL has no log1p,
 // and fp32 log(u) near u = 1 is only accurate in absolute terms, which at
@@ -26,13 +27,29 @@ float log1p_ratio(float s2) {
     return log(u) / (u - 1.0);
 }
 
+float ashikhmin_norm(float ex, float ey) {
+    return sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI;
+}
+
+// ½·log(hz²)/|h|² = −½·log1p_ratio(|h|²): what eq. 1's exponent (ex·hx² + ey·hy²) is
+// multiplied by before exp. A turn of h keeps |h|, so the rotation source takes it once
+// for all its channels or wavelengths (material.glsl, environment_light.glsl).
+float ashikhmin_log_scale(real2 h) {
+    return -0.5 * log1p_ratio(min(float(dot(h, h)), 1.0));
+}
+
+// Eq. 1 without its norm at h turned by cs (eq. 2's rotation), given h's log scale.
+float ashikhmin_turned(real2 h, real2 cs, float log_scale, float ex, float ey) {
+    vec2 r = vec2(rotate_half(h, cs));
+    return exp(log_scale * (ex * r.x * r.x + ey * r.y * r.y));
+}
+
 float mdf_ashikhmin(real2 h, float hz, float ex, float ey) {
     float hx2 = float(h.x * h.x);
     float hy2 = float(h.y * h.y);
     float s2 = min(hx2 + hy2, 1.0);
     float log_term = -0.5 * (ex * hx2 + ey * hy2) * log1p_ratio(s2);
-    float norm = sqrt((ex + 1.0) * (ey + 1.0)) / TWO_PI;
-    return hz > 0.0 ? norm * exp(log_term) : 0.0;
+    return hz > 0.0 ? ashikhmin_norm(ex, ey) * exp(log_term) : 0.0;
 }
 
 #endif

@@ -51,8 +51,11 @@ class EnvironmentMaps:
         radiance, directions, lights = split_bright(resolve_map(name, self.environments_dir))
         height, width = radiance.shape[:2]
         # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
-        data = np.ascontiguousarray(radiance[::-1], dtype="f4")
-        texture = self.ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
+        # RGBA, the fourth channel unread: llvmpipe fetches 16-byte texels faster than
+        # 12-byte ones (the studio at standard, 9 lobe samples: ~10 % of the render).
+        rgba = np.concatenate([radiance[::-1], np.ones((height, width, 1), radiance.dtype)], 2)
+        texture = self.ctx.texture((width, height), 4,
+                                   np.ascontiguousarray(rgba, dtype="f4").tobytes(), dtype="f4")
         # The one place the map's sampling is set: environment light (filtered
         # importance sampling) and the backdrop's blur read this chain.
         texture.build_mipmaps()
