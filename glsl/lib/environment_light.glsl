@@ -176,6 +176,40 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 #endif
 }
 
+#ifdef ENV_QUAD_MEAN
+// The mean of a value over the pixel's 2×2 quad, from fine derivatives (each row's and each
+// column's own difference; GL's plain dFdx may be the quad's coarse one). The rotation
+// source's few map samples are independent from pixel to pixel, so the quad's four pixels
+// pool theirs: a quarter of the variance, for a 2×2 blur of the reflection (the brute-force
+// reference, the lobe probe and the shared-nothing tiers compile it out). Twin:
+// opaline.model.environment_light.quad_means.
+#ifdef GL_ARB_derivative_control
+#define QUAD_DX dFdxFine
+#define QUAD_DY dFdyFine
+#else
+#define QUAD_DX dFdx
+#define QUAD_DY dFdy
+#endif
+vec3 quad_mean(vec3 value) {
+    // +1 in a quad's left column and bottom row, where the difference is to the next pixel.
+    vec2 side = 1.0 - 2.0 * mod(floor(gl_FragCoord.xy), 2.0);
+    vec3 row = value + 0.5 * side.x * QUAD_DX(value);
+    return row + 0.5 * side.y * QUAD_DY(row);
+}
+
+// How much of the quad's mean to take: all of it where the lobe's reflection, at its
+// wider width 2/√min(ex, ey), spans at least two of the mirror direction's steps from
+// pixel to pixel (the pool's blur is then inside the lobe), none where it spans one or
+// less (a mirror: every sample reads one direction, and pooling only blurs; on the
+// mirror sphere it took FLIP from 0.017 to 0.029).
+float quad_pool_weight(Material mat, vec3 n, vec3 v) {
+    vec3 r = reflect(-v, n);
+    float pixel_step = length(abs(QUAD_DX(r)) + abs(QUAD_DY(r)));
+    float lobe_width = 2.0 * inversesqrt(max(min(mat.ex, mat.ey), 1.0));
+    return clamp(lobe_width / max(pixel_step, 1e-6) - 1.0, 0.0, 1.0);
+}
+#endif
+
 vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
 #ifdef ENV_GRATING_ORDERS
     return environment_grating(mat, env, frame, v);
@@ -225,6 +259,9 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
 #ifdef ENV_ENVELOPE
     // Each wavelength once a pass: the sum is the pass's estimate of the bands.
     return radiance_floor(sum + specular_envelope(mat, env, vec3(frame[2]), v));
+#elif defined(ENV_QUAD_MEAN)
+    vec3 own = sum / float(ENV_SAMPLES);
+    return mix(own, quad_mean(own), quad_pool_weight(mat, vec3(frame[2]), v));
 #else
     return sum / float(ENV_SAMPLES);
 #endif

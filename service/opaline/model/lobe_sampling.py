@@ -1,5 +1,5 @@
-"""Float64 twin of ``glsl/lib/lobe_sampling.glsl`` and of the sequence and mixture in
-``glsl/lib/environment_light.glsl``: directions drawn from the material's lobe.
+"""Float64 twin of ``glsl/lib/lobe_sampling.glsl`` and of the sequence, mixture and quad mean
+in ``glsl/lib/environment_light.glsl``: directions drawn from the material's lobe.
 
 Each sampler maps uniforms ``u`` (..., 2) in [0, 1)² to a half vector in the shading
 frame and its density per unit solid angle of h. The Ashikhmin-Shirley sampler's
@@ -88,3 +88,17 @@ def pixel_shift(x: npt.ArrayLike, y: npt.ArrayLike) -> FloatArray:
                                    ((h >> 10) & np.uint64(1023)).astype(np.float64) / 1024.0,
                                    (h >> 20).astype(np.float64) / 4096.0], axis=-1)
     return result
+
+
+def quad_means(image: npt.ArrayLike) -> FloatArray:
+    """Every pixel of ``image`` (rows, columns, channels; an even number of rows and of
+    columns) as the mean over its 2×2 quad, as ``quad_mean`` pools the rotation source's
+    map samples: GL's quads start at even window coordinates, and with an even height the
+    image's rows, stored top first, pair up the same way."""
+    data = np.asarray(image, dtype=np.float64)
+    rows, cols = data.shape[:2]
+    if rows % 2 or cols % 2:
+        raise ValueError(f"quads need an even size, not {rows}×{cols}")
+    blocks = data.reshape(rows // 2, 2, cols // 2, 2, -1).mean(axis=(1, 3), keepdims=True)
+    result: FloatArray = np.broadcast_to(blocks, (rows // 2, 2, cols // 2, 2, blocks.shape[-1]))
+    return result.reshape(data.shape).copy()

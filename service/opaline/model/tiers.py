@@ -47,9 +47,11 @@ class Tier:
     # (glsl/lib/environment_light.glsl), over all the tier's samples together.
     environment_samples: int
     # The same for the rotation source's three Ashikhmin-Shirley lobes (at draft and
-    # standard a multiple of 3 a pass, so each lobe gets its third): against the
-    # brute-force reference (studio, A-S 100×1000, θ 0.5/1.0) 6 left FLIP 0.106, 9 0.088,
-    # 12 0.079 (bench/environment_accuracy.py).
+    # standard a multiple of 3 a pass, so each lobe gets its third), pooled over each 2×2
+    # quad of pixels where the lobe is wider than a pixel's step (ENV_QUAD_MEAN): against
+    # the brute-force reference (studio, A-S 100×1000, θ 0.5/1.0, 128²) 3 left FLIP 0.111
+    # and 6 0.086, where unpooled 3 left 0.128, 6 0.102 and 9 0.084
+    # (bench/environment_accuracy.py).
     environment_samples_rotation: int
     # A grating's pieces of the curve its orders leave along, each read once
     # (glsl/lib/environment_grating.glsl), over all the tier's samples together: against
@@ -120,7 +122,7 @@ TIERS: dict[str, Tier] = {tier.name: tier for tier in (
          stack_wavelengths=0),
     # FLIP <= 0.05 on every preset at about 1.5x draft's time.
     Tier("standard", samples=1, wavelengths=16, aa="analytic",
-         environment_lights=16, environment_samples=6, environment_samples_rotation=9,
+         environment_lights=16, environment_samples=6, environment_samples_rotation=6,
          environment_samples_grating=3, film_wavelengths=0, metal_film_wavelengths=16,
          stack_wavelengths=32),
     # FLIP <= 0.01 on the paper's presets; the wavelengths move between samples
