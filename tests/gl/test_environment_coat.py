@@ -62,12 +62,14 @@ def test_the_coats_estimate_is_its_albedo_in_a_uniform_surround(renderer, grey_m
     np.testing.assert_allclose(estimate, expected, rtol=rtol)
 
 
-def test_a_white_lambertian_under_a_mirror_coat_stays_the_surround(backend, grey_map):
+def test_a_white_lambertian_under_a_mirror_coat_stays_the_surround(backend, grey_map,
+                                                                   renderer):
     """kd·albedo = 1 in a uniform L is L; a mirror coat reflects F(n·v)·L and lets
     (1 − F(n·v))·L through: L again, to the coat albedo's 0.5 % off F. Without the dimming
     it would be (1 + F)·L, 4 % over face-on and more toward the rim."""
     from opaline.gl.renderer import Renderer
 
+    session = renderer
     renderer = Renderer(backend, environments_dir=grey_map)
     try:
         preset = get_preset("sphere")
@@ -80,6 +82,9 @@ def test_a_white_lambertian_under_a_mirror_coat_stays_the_surround(backend, grey
             images[weight] = renderer.render(resolve(request, preset), preset=preset).linear
     finally:
         renderer.release()
+        # Its own context was current: the session's is again, for the tests that use
+        # its context directly (on OSMesa a texture made on no current context fails).
+        session.gl.make_current()
     covered = images[1.0][..., 3] == 1.0
     # Inside 0.8 of the disc's radius, n·v ≥ 0.6: toward grazing the coat's lobe dips
     # below the horizon and its albedo falls under F (as the float64 integral does).
