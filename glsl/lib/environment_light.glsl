@@ -129,11 +129,8 @@ vec4 env_sample_half(Material mat, Environment env, vec3 u) {
     vec4 s = sample_ashikhmin(u.xy, mat.ex, mat.ey);
     vec2 cs = env.lobe_rotation[c];
     vec3 h = vec3(cs.x * s.x + cs.y * s.y, cs.x * s.y - cs.y * s.x, s.z);
-    float log_scale = ashikhmin_log_scale(h.xy);
-    for (int i = 0; i < 3; ++i) {
-        g_env_lobes[i] = ashikhmin_turned(h.xy, env.lobe_rotation[i], log_scale, mat.ex, mat.ey);
-    }
-    g_env_lobes *= h.z > 0.0 ? ashikhmin_norm(mat.ex, mat.ey) : 0.0;
+    g_env_lobes = mdf_ashikhmin_three(h.xy, h.z, mat.ex, mat.ey, env.lobe_rotation[0],
+                                      env.lobe_rotation[1], env.lobe_rotation[2]);
     return vec4(h, (g_env_lobes.x + g_env_lobes.y + g_env_lobes.z) / 3.0);
 #endif
 }
@@ -182,7 +179,7 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 // source's few map samples are independent from pixel to pixel, so the quad's four pixels
 // pool theirs: a quarter of the variance, for a 2×2 blur of the reflection (the brute-force
 // reference, the lobe probe and the shared-nothing tiers compile it out). Twin:
-// opaline.model.environment_light.quad_means.
+// opaline.model.lobe_sampling.quad_means.
 #ifdef GL_ARB_derivative_control
 #define QUAD_DX dFdxFine
 #define QUAD_DY dFdyFine

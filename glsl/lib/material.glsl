@@ -113,11 +113,8 @@ vec3 mdf_color(Material mat, real2 h, float hz) {
 }
 #elif defined(MDF_ASHIKHMIN)
 vec3 mdf_color(Material mat, real2 h, float hz) {
-    float log_scale = ashikhmin_log_scale(h);
-    vec3 d = vec3(ashikhmin_turned(h, mat.rotation[0], log_scale, mat.ex, mat.ey),
-                  ashikhmin_turned(h, mat.rotation[1], log_scale, mat.ex, mat.ey),
-                  ashikhmin_turned(h, mat.rotation[2], log_scale, mat.ex, mat.ey));
-    return hz > 0.0 ? ashikhmin_norm(mat.ex, mat.ey) * d : vec3(0.0);
+    return mdf_ashikhmin_three(h, hz, mat.ex, mat.ey, mat.rotation[0], mat.rotation[1],
+                               mat.rotation[2]);
 }
 #else
 vec3 mdf_color(Material mat, real2 h, float hz) {

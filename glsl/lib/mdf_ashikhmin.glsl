@@ -44,6 +44,17 @@ float ashikhmin_turned(real2 h, real2 cs, float log_scale, float ex, float ey) {
     return exp(log_scale * (ex * r.x * r.x + ey * r.y * r.y));
 }
 
+// Eq. 1 at h turned by three angles (the paper's R, G, B channels, eq. 2): one logarithm
+// for the three.
+vec3 mdf_ashikhmin_three(real2 h, float hz, float ex, float ey, real2 t0, real2 t1,
+                         real2 t2) {
+    float log_scale = ashikhmin_log_scale(h);
+    vec3 d = vec3(ashikhmin_turned(h, t0, log_scale, ex, ey),
+                  ashikhmin_turned(h, t1, log_scale, ex, ey),
+                  ashikhmin_turned(h, t2, log_scale, ex, ey));
+    return hz > 0.0 ? ashikhmin_norm(ex, ey) * d : vec3(0.0);
+}
+
 float mdf_ashikhmin(real2 h, float hz, float ex, float ey) {
     float hx2 = float(h.x * h.x);
     float hy2 = float(h.y * h.y);

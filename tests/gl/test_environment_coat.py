@@ -69,8 +69,7 @@ def test_a_white_lambertian_under_a_mirror_coat_stays_the_surround(backend, grey
     it would be (1 + F)·L, 4 % over face-on and more toward the rim."""
     from opaline.gl.renderer import Renderer
 
-    session = renderer
-    renderer = Renderer(backend, environments_dir=grey_map)
+    own = Renderer(backend, environments_dir=grey_map)
     try:
         preset = get_preset("sphere")
         images = {}
@@ -79,12 +78,12 @@ def test_a_white_lambertian_under_a_mirror_coat_stays_the_surround(backend, grey
                                     quality="high", environment="grey.hdr", kd=1.0, ks=0.0,
                                     albedo=(1.0, 1.0, 1.0), coat_weight=weight,
                                     coat_roughness=0.0)
-            images[weight] = renderer.render(resolve(request, preset), preset=preset).linear
+            images[weight] = own.render(resolve(request, preset), preset=preset).linear
     finally:
-        renderer.release()
+        own.release()
         # Its own context was current: the session's is again, for the tests that use
         # its context directly (on OSMesa a texture made on no current context fails).
-        session.gl.make_current()
+        renderer.gl.make_current()
     covered = images[1.0][..., 3] == 1.0
     # Inside 0.8 of the disc's radius, n·v ≥ 0.6: toward grazing the coat's lobe dips
     # below the horizon and its albedo falls under F (as the float64 integral does).

@@ -1,12 +1,12 @@
 """The rotation source's map samples pooled over each 2×2 quad of pixels (ENV_QUAD_MEAN in
-glsl/lib/environment_light.glsl) against its float64 twin, ``lobe_sampling.quad_means``:
-on a lobe far wider than a pixel's step (pooled in full) the same render without the
+glsl/lib/environment_light.glsl) against its float64 twin, ``lobe_sampling.quad_means``.
+On a lobe far wider than a pixel's step (pooled in full) the same render without the
 pooling, averaged quad by quad, must give the pooled render where all four pixels of a
-quad lie on one triangle (the driver shades a quad once per
-triangle it touches, the others' pixels as helpers: there the mean takes their values
-extended from the triangle's plane). The driver's derivatives have to be fine ones (each
-row its own difference) for that to hold. On a mirror (a lobe narrower than a pixel's
-step, not pooled) the two renders must be the same."""
+quad lie on one triangle (the driver shades a quad once per triangle it touches, the
+others' pixels as helpers: there the mean takes their values extended from the
+triangle's plane). The driver's derivatives have to be fine ones (each row its own
+difference) for that to hold. On a mirror (a lobe narrower than a pixel's step, not
+pooled) the two renders must be the same."""
 
 from __future__ import annotations
 
@@ -49,12 +49,10 @@ def unpooled(monkeypatch) -> None:
     monkeypatch.setattr(environment_light, "defines", without_quad_mean)
 
 
-@pytest.mark.parametrize("tier,wavelengths", [("standard", None), ("draft", None),
-                                              ("standard", 0)],
+@pytest.mark.parametrize("fields", [{"quality": "standard"}, {"quality": "draft"},
+                                    {"quality": "standard", "wavelengths": 0}],
                          ids=["standard", "draft", "rgb"])
-def test_quad_mean_pools_each_quads_samples(renderer, monkeypatch, tier, wavelengths):
-    fields = {"quality": tier} if wavelengths is None else {"quality": tier,
-                                                            "wavelengths": wavelengths}
+def test_quad_mean_pools_each_quads_samples(renderer, monkeypatch, fields):
     pooled = render(renderer, **fields)
     with monkeypatch.context() as patch:
         unpooled(patch)

@@ -99,6 +99,6 @@ def quad_means(image: npt.ArrayLike) -> FloatArray:
     rows, cols = data.shape[:2]
     if rows % 2 or cols % 2:
         raise ValueError(f"quads need an even size, not {rows}×{cols}")
-    blocks = data.reshape(rows // 2, 2, cols // 2, 2, -1).mean(axis=(1, 3), keepdims=True)
-    result: FloatArray = np.broadcast_to(blocks, (rows // 2, 2, cols // 2, 2, blocks.shape[-1]))
-    return result.reshape(data.shape).copy()
+    means = data.reshape(rows // 2, 2, cols // 2, 2, -1).mean(axis=(1, 3))
+    result: FloatArray = means.repeat(2, axis=0).repeat(2, axis=1).reshape(data.shape)
+    return result
