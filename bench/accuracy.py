@@ -176,10 +176,14 @@ def last_run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> dict:
 
 def merged(old: dict, new: dict, names: list[str]) -> dict:
     """The last run's results with ``names``' rows, facts and tier ratios from ``new``; the
-    info is the last run's, with this run noted (what it measured, when, how long)."""
+    info is the last run's, with this run noted (what it measured, when, how long) in
+    place of earlier merges whose presets it measured again."""
     keep = set(names)
-    info = {**old["info"], "merged": [*old["info"].get("merged", []), {
-        key: new["info"][key] for key in ("command", "date", "wall_s", "load")}]}
+    earlier = [m for m in old["info"].get("merged", [])
+               if not ("presets" in m and set(m["presets"]) <= keep)]
+    info = {**old["info"], "merged": [*earlier, {
+        **{key: new["info"][key] for key in ("command", "date", "wall_s", "load")},
+        "presets": sorted(keep)}]}
     return {"info": info,
             "rows": [r for r in old["rows"] if r["preset"] not in keep] + new["rows"],
             "facts": [f for f in old["facts"] if f["preset"] not in keep] + new["facts"],
