@@ -1,4 +1,5 @@
-"""The rotation source's map samples pooled over each 2×2 quad of pixels (ENV_QUAD_MEAN in
+"""The map samples of the rotation source and of a film pooled over each 2×2 quad of
+pixels (ENV_QUAD_MEAN in
 glsl/lib/environment_light.glsl) against its float64 twin, ``lobe_sampling.quad_means``.
 On a lobe far wider than a pixel's step (pooled in full) the same render without the
 pooling, averaged quad by quad, must give the pooled render where all four pixels of a
@@ -49,9 +50,15 @@ def unpooled(monkeypatch) -> None:
     monkeypatch.setattr(environment_light, "defines", without_quad_mean)
 
 
+FILM = {"iridescence": "thin-film", "film_ior": 1.33, "film_thickness_min": 300.0,
+        "film_thickness_max": 600.0}
+
+
 @pytest.mark.parametrize("fields", [{"quality": "standard"}, {"quality": "draft"},
-                                    {"quality": "standard", "wavelengths": 0}],
-                         ids=["standard", "draft", "rgb"])
+                                    {"quality": "standard", "wavelengths": 0},
+                                    {"quality": "standard", **FILM},
+                                    {"quality": "draft", **FILM}],
+                         ids=["standard", "draft", "rgb", "film-standard", "film-draft"])
 def test_quad_mean_pools_each_quads_samples(renderer, monkeypatch, fields):
     pooled = render(renderer, **fields)
     with monkeypatch.context() as patch:
@@ -78,9 +85,10 @@ def test_a_mirror_is_not_pooled(renderer, monkeypatch):
     np.testing.assert_array_equal(pooled, each)
 
 
-def test_pooling_is_only_for_the_rotation_sources_shared_samples(renderer):
-    """The brute-force reference, a tier whose samples are not shared (high's 64) and the
-    other colour sources read every pixel's own samples, as the lobe probe does."""
+def test_pooling_is_only_for_shared_lobe_samples(renderer):
+    """The rotation source's and a film's few samples pool. The brute-force reference, a
+    tier whose samples are not shared (high's 64), a grating's reads and the multi-peak
+    bands read every pixel's own, as the lobe probe does."""
     preset = get_preset(SCENE)
     environment = renderer.environments.get("neutral")
 
@@ -94,4 +102,8 @@ def test_pooling_is_only_for_the_rotation_sources_shared_samples(renderer):
     assert pooled("standard") and pooled("draft") and pooled("standard", wavelengths=0)
     assert not pooled("standard", brute=True)
     assert not pooled("high")
-    assert not pooled("standard", iridescence="thin-film")
+    assert pooled("standard", **FILM) and pooled("draft", **FILM)
+    assert pooled("standard", **{**FILM, "mdf": "multipeak"})  # a film's lobe is A-S
+    assert not pooled("high", **FILM) and not pooled("standard", brute=True, **FILM)
+    assert not pooled("standard", iridescence="grating")
+    assert not pooled("standard", mdf="multipeak")

@@ -26,7 +26,7 @@ from opaline.model.stack_film import is_stack
 
 # From this many samples a pixel, the film is evaluated at each sample's own v·h, and the
 # rotation source's map samples take its spectral colour; below (draft's 2 and 3,
-# standard's 6), the film once a pixel at the v·h its light came from, and the
+# standard's 4 and 6), the film once a pixel at the v·h its light came from, and the
 # paper's three channels (glsl/lib/environment_light.glsl, docs/design.md §4.5). Against
 # the brute-force reference (bench/environment_accuracy.py, studio, 128², standard) the
 # film once a pixel measured FLIP 0.020 on a glossy film and 0.030-0.046 on broad ones,
@@ -65,17 +65,23 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
     # (bragg-mirror's 128² ground truth: an estimated 33 min with it at every sample, 1.3 once).
     film_shared = shared or (not brute and is_stack(material))
     # The rotation source's three lobes at few samples: the paper's channels at its map
-    # samples (spectral ones) and the samples pooled over the pixel's 2×2 quad.
+    # samples (spectral ones).
     three_lobes = material.iridescence == "rotation" and material.mdf == "ashikhmin" and shared
+    film_per_pixel = material.iridescence == "thin-film" and film_shared
     return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples, brute),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
             "ENV_GRATING_ORDERS": reads_orders(job) and not brute,
             "ENV_GRATING_READS": grating_reads(job, samples, brute) or False,
-            "FILM_PER_PIXEL": material.iridescence == "thin-film" and film_shared,
+            "FILM_PER_PIXEL": film_per_pixel,
             "ENV_RGB_LOBES": three_lobes and job.wavelengths > 0,
-            "ENV_QUAD_MEAN": three_lobes,
+            # A few A-S lobe samples a pixel (a film's lobe is always A-S), the rotation's
+            # or a film's, pooled over the pixel's 2×2 quad where the lobe is wider than a
+            # pixel's step (a film: its colour at the pixel's own v·h times its own light,
+            # then the quad's mean). A grating's reads and the multi-peak bands are not:
+            # pooling left the gratings' error where it was (docs/design.md §4.5).
+            "ENV_QUAD_MEAN": shared and (three_lobes or film_per_pixel),
             "LIGHT_COUNT": lights if lights else False,
             # A lobe sample's h is drawn anew in each pixel, so the pixel filter's screen
             # derivative of the multi-peak phase at it means nothing: the brute-force
