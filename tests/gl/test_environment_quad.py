@@ -1,13 +1,12 @@
-"""The map samples of the rotation source and of a film pooled over each 2×2 quad of
-pixels (ENV_QUAD_MEAN in
-glsl/lib/environment_light.glsl) against its float64 twin, ``lobe_sampling.quad_means``.
-On a lobe far wider than a pixel's step (pooled in full) the same render without the
-pooling, averaged quad by quad, must give the pooled render where all four pixels of a
-quad lie on one triangle (the driver shades a quad once per triangle it touches, the
-others' pixels as helpers: there the mean takes their values extended from the
-triangle's plane). The driver's derivatives have to be fine ones (each row its own
-difference) for that to hold. On a mirror (a lobe narrower than a pixel's step, not
-pooled) the two renders must be the same."""
+"""The map samples of the rotation source and of a film pooled over each 2×2 quad of pixels
+(ENV_QUAD_MEAN in glsl/lib/environment_light.glsl) against its float64 twin,
+``lobe_sampling.quad_means``. On a lobe far wider than a pixel's step (pooled in full)
+the same render without the pooling, averaged quad by quad, must give the pooled render
+where all four pixels of a quad lie on one triangle (the driver shades a quad once per
+triangle it touches, the others' pixels as helpers: there the mean takes their values
+extended from the triangle's plane). The driver's derivatives have to be fine ones (each
+row its own difference) for that to hold. On a mirror (a lobe narrower than a pixel's
+step, not pooled) the two renders must be the same."""
 
 from __future__ import annotations
 
