@@ -175,10 +175,11 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 
 #ifdef ENV_QUAD_MEAN
 // The mean of a value over the pixel's 2×2 quad, from fine derivatives (each row's and each
-// column's own difference; GL's plain dFdx may be the quad's coarse one). The rotation
-// source's few map samples are independent from pixel to pixel, so the quad's four pixels
-// pool theirs: a quarter of the variance, for a 2×2 blur of the reflection (the brute-force
-// reference, the lobe probe and the shared-nothing tiers compile it out). Twin:
+// column's own difference; GL's plain dFdx may be the quad's coarse one). The few map
+// samples of the rotation source and of a film evaluated once a pixel are independent from
+// pixel to pixel, so the quad's four pixels pool theirs: a quarter of the variance, for a
+// 2×2 blur of the reflection (the brute-force reference, the lobe probe and the
+// shared-nothing tiers compile it out; gl/environment_light.py decides). Twin:
 // opaline.model.lobe_sampling.quad_means.
 #ifdef GL_ARB_derivative_control
 #define QUAD_DX dFdxFine

@@ -63,6 +63,21 @@ float order_lobe(Material mat, vec3 k, vec3 vl, float cos_max) {
     return material_fresnel(mat, vh) * mdf_ashikhmin(h.xy, h.z, mat.ex, mat.ey) * max(vh, 0.0) / (k2 * cos_max);
 }
 
+// Whether any order's lobe can be above 0, k = l + v in the frame. Every order's h is k
+// shifted along b, normalised: its n component is at most k's with k_b = 0, h0, and eq.
+// 1's exponent (ex·hx² + ey·hy²)/(1 - hz²) is a mean of ex and ey, so each lobe is at most
+// its norm times h0^min(ex, ey). Below 2^-150 of the norm (under float's least value,
+// with room for rounding) every lobe's exp is exactly 0. Where |k| without its b part is
+// under order_lobe's floor, h is not a unit vector and the bound does not hold.
+bool grating_lobes_reach(Material mat, vec3 k) {
+    float across = k.x * k.x + k.z * k.z;
+    if (!(across >= EPS_K2)) {
+        return true;
+    }
+    float h0 = k.z * inversesqrt(across);
+    return h0 > 0.0 && min(mat.ex, mat.ey) * log2(h0) > -150.0;
+}
+
 #if WAVELENGTHS > 0
 // Orders ±m at one wavelength: J_{-m}² = J_m², so one series serves both signs.
 float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, float cos_max) {
@@ -77,34 +92,39 @@ float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, 
 // large is not unrolled by Mesa, and its divisions cost a quarter of the draw).
 vec3 grating_color_spectral(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
-    float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
-    for (int i = 0; i < WAVELENGTHS; ++i) {
-        float lam = u_wavelength_nm[i];
-        float step_b = lam / mat.grating.pitch_nm;
-        float s = grating_efficiency(0, lam, k.z, mat.grating.depth_nm) * zero;
-        s += order_pair(mat, 1, lam, step_b, k, vl, cos_max);
+    // Off the streak across the grooves every order's lobe is exactly 0 at every
+    // wavelength (grating_lobes_reach): the loop is skipped there, which changes no value
+    // and spares llvmpipe all of it wherever a block of pixels is off the streak.
+    if (grating_lobes_reach(mat, k)) {
+        float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
+        for (int i = 0; i < WAVELENGTHS; ++i) {
+            float lam = u_wavelength_nm[i];
+            float step_b = lam / mat.grating.pitch_nm;
+            float s = grating_efficiency(0, lam, k.z, mat.grating.depth_nm) * zero;
+            s += order_pair(mat, 1, lam, step_b, k, vl, cos_max);
 #if GRATING_ORDERS >= 2
-        s += order_pair(mat, 2, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 2, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 3
-        s += order_pair(mat, 3, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 3, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 4
-        s += order_pair(mat, 4, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 4, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 5
-        s += order_pair(mat, 5, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 5, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 6
-        s += order_pair(mat, 6, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 6, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 7
-        s += order_pair(mat, 7, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 7, lam, step_b, k, vl, cos_max);
 #endif
 #if GRATING_ORDERS >= 8
-        s += order_pair(mat, 8, lam, step_b, k, vl, cos_max);
+            s += order_pair(mat, 8, lam, step_b, k, vl, cos_max);
 #endif
-        sum += u_spectral_weight[i] * s;
+            sum += u_spectral_weight[i] * s;
+        }
     }
     return radiance_floor(sum);
 }
