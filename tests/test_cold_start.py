@@ -17,8 +17,9 @@ from PIL import Image
 from opaline.setting_defaults import DEFAULT_COST_BUDGET, DEFAULTS
 from opaline.settings import Settings, SettingsError, get_settings, setting
 
-# Each cost a cold draft render 5-25 ms and none is needed by one.
-NOT_IMPORTED = ("pydantic_settings", "opaline.service_settings", "pyrr", "PIL", "numpy.ma")
+# Each cost a cold draft render 5-40 ms and none is needed by one.
+NOT_IMPORTED = ("pydantic_settings", "opaline.service_settings", "pyrr", "PIL", "numpy.ma",
+                "pygltflib")
 
 
 @pytest.mark.gl

@@ -18,10 +18,12 @@ import struct
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pygltflib as gl
+
+if TYPE_CHECKING:
+    import pygltflib as gl
 
 IRIDESCENCE = "KHR_materials_iridescence"
 # A texture's texels at most: a generated thickness field's largest (thickness.RESOLUTION).
@@ -48,6 +50,10 @@ class FilmTextures:
 
 def load_document(data: bytes) -> gl.GLTF2:
     """A .glb's document; ValueError saying why where the bytes are not one."""
+    # Imported here: the presets' module imports this one, and pygltflib was ~40 ms of a
+    # cold `opaline render` that reads no .glb (tests/test_cold_start.py).
+    import pygltflib as gl
+
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # pygltflib warns, then may answer None
