@@ -64,18 +64,20 @@ float order_lobe(Material mat, vec3 k, vec3 vl, float cos_max) {
 }
 
 // Whether any order's lobe can be above 0, k = l + v in the frame. Every order's h is k
-// shifted along b, normalised: its n component is at most k's with k_b = 0, h0, and eq.
-// 1's exponent (ex·hx² + ey·hy²)/(1 - hz²) is a mean of ex and ey, so each lobe is at most
-// its norm times h0^min(ex, ey). Below 2^-150 of the norm (under float's least value,
-// with room for rounding) every lobe's exp is exactly 0. Where |k| without its b part is
-// under order_lobe's floor, h is not a unit vector and the bound does not hold.
+// shifted along b, normalised: its n component is at most h0, k's with k_b = 0, and eq. 1's
+// exponent (ex·hx² + ey·hy²)/(hx² + hy²) is a mean of ex and ey, so each lobe is at most
+// its norm times hz^min(ex, ey). mdf_ashikhmin takes hz² as 1 - (hx² + hy²), which its
+// rounding may leave up to ~1e-6 above h0² where hz is tiny: the bound uses h0² + 1e-6.
+// Under 2^-160 of the norm (11 binades below float's least value) every lobe's exp is 0.
+// Where |k| without its b part is under order_lobe's floor, h is not a unit vector and
+// the bound does not hold.
 bool grating_lobes_reach(Material mat, vec3 k) {
     float across = k.x * k.x + k.z * k.z;
     if (!(across >= EPS_K2)) {
         return true;
     }
     float h0 = k.z * inversesqrt(across);
-    return h0 > 0.0 && min(mat.ex, mat.ey) * log2(h0) > -150.0;
+    return h0 > 0.0 && min(mat.ex, mat.ey) * log2(h0 * h0 + 1e-6) > -320.0;
 }
 
 #if WAVELENGTHS > 0
@@ -92,9 +94,10 @@ float order_pair(Material mat, int m, float lam, float step_b, vec3 k, vec3 vl, 
 // large is not unrolled by Mesa, and its divisions cost a quarter of the draw).
 vec3 grating_color_spectral(Material mat, vec3 k, vec3 vl, float cos_max) {
     vec3 sum = vec3(0.0);
-    // Off the streak across the grooves every order's lobe is exactly 0 at every
-    // wavelength (grating_lobes_reach): the loop is skipped there, which changes no value
-    // and spares llvmpipe all of it wherever a block of pixels is off the streak.
+    // Off the streak every order's lobe is exactly 0 at every wavelength
+    // (grating_lobes_reach): the loop is skipped there, which changes no value, and
+    // llvmpipe, which only masks an if, leaves the loop after one pass where no pixel of
+    // its block is in it.
     if (grating_lobes_reach(mat, k)) {
         float zero = order_lobe(mat, k, vl, cos_max);  // the mirror order: the same at every λ
         for (int i = 0; i < WAVELENGTHS; ++i) {
@@ -167,10 +170,9 @@ vec3 grating_color_visible(Material mat, vec3 k, vec3 vl, float cos_max) {
     float k0_len = sqrt(max(dot(k0, k0), EPS_K2));
     float width = sqrt(TWO_PI / max(mat.ey, 1.0));
     vec3 sum = vec3(0.0);
-    // Off the streak across the grooves the lobe's power underflows to 0, and every
-    // order's term with it: the orders are skipped there, which changes no value and
-    // spares llvmpipe the whole loop wherever a block of pixels is off the streak (the
-    // studio's hard light on cd-rom-grating at draft: 2.1 -> 1.7x its key light).
+    // Off the streak the lobe's power underflows to 0, and every order's term with it:
+    // the orders are skipped there, which changes no value, and llvmpipe, which only
+    // masks an if, leaves their loop after one pass where no pixel of its block is in it.
     if (base > 0.0) {
         for (int m = 1; m <= GRATING_ORDERS; ++m) {
             float spread = mat.grating.pitch_nm / float(m) * k0_len * width;
