@@ -49,6 +49,21 @@ def test_upload_then_render_each_format(client, fmt):
 
 
 @pytest.mark.gl
+def test_mesh_renders_are_timed_under_the_preset_they_name(client):
+    """Each upload is a scene of its own (named by its digest); the render-time histogram
+    labels it by the preset the request names, so uploads cannot grow the metrics. Before,
+    every mesh rendered added a label (a series of buckets) of its own."""
+    for fmt in FORMATS[:2]:
+        info = client.post("/v1/meshes", content=mesh_bytes(fmt)).json()
+        assert client.get(f"/v1/render?preset=nacre&mesh={info['id']}&{SMALL}"
+                          "&camera_azimuth=33").status_code == 200
+    text = client.get("/metrics").text
+    labels = {line.split('preset="')[1].split('"')[0] for line in text.splitlines()
+              if line.startswith("opaline_render_seconds_count{")}
+    assert "nacre" in labels and not any(name.startswith("mesh-") for name in labels), labels
+
+
+@pytest.mark.gl
 def test_folder_meshes_by_name(client):
     assert client.get(f"/v1/render?mesh=shelf.ply&{SMALL}").status_code == 200
     for name in ("../shelf.ply", "missing.ply", "0" * 32):

@@ -25,7 +25,7 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
 # uncalibrated cost model, 14 s for 17 presets (tasks.CalibrateTask.units), which had
 # outgrown 15 s with the page's own work.
 WAIT_MS = 30_000
-START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up render
+START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up, calibration
 
 _spec = importlib.util.spec_from_file_location("opaline_bench_web_drag",
                                                ROOT / "bench" / "web_drag.py")
@@ -38,9 +38,11 @@ pytestmark = pytest.mark.skipif(not CHROMIUM.exists(),
 
 @pytest.fixture(scope="module")
 def server():
-    """``opaline serve`` as a real uvicorn process on a free port of 127.0.0.1."""
+    """``opaline serve`` as a real uvicorn process on a free port of 127.0.0.1, once ready
+    (/readyz: calibrated). Before, the page opened at /healthz met the calibration's 503 and
+    its Retry-After of 16 s, half of a wait's 30 s on a loaded machine."""
     try:
-        with LocalServer(workers=1, ready_path="/healthz", start_timeout_s=START_S) as local:
+        with LocalServer(workers=1, ready_path="/readyz", start_timeout_s=START_S) as local:
             yield local.base
     except ServerError as exc:
         pytest.fail(str(exc))
@@ -338,7 +340,7 @@ def test_page_works_with_keys_and_signing_on(browser):
     key = "web-key-7d2e"
     env = {"OPALINE_API_KEYS": key, "OPALINE_SIGNING_KEY": "web-secret-19aa"}
     try:
-        with LocalServer(workers=1, env=env, ready_path="/healthz", start_timeout_s=START_S) as local:
+        with LocalServer(workers=1, env=env, ready_path="/readyz", start_timeout_s=START_S) as local:
             context = browser.new_context()
             context.set_default_timeout(WAIT_MS)
             page = context.new_page()

@@ -9,11 +9,13 @@ import os
 
 import pytest
 
+from mesh_helpers import mesh_bytes
 from opaline.local.context import local_context
 from opaline.model.params import RenderRequest
+from opaline.model.presets import get_preset
 from opaline.pipeline.prepare import prepare
 from opaline.workers.admission import CostModel, TooSlow, admit
-from opaline.workers.tasks import ImageTask
+from opaline.workers.tasks import CalibrateTask, ImageTask
 
 # CalibrateTask's answer as a worker gave it for 'sphere' (192², 2 samples; 0 and 16
 # wavelengths) and the tiny render's overhead.
@@ -85,6 +87,57 @@ def test_a_variant_no_worker_rendered_yet_pays_its_compile():
     other = ImageTask(prepare(RenderRequest(preset="sphere", width=64, height=64,
                                             wavelengths=8), local_context(None)))
     assert found.predict_task(other) > found.predict(*other.units())  # another program
+
+
+def _calibration_task(preset: str, wavelengths: int = 0) -> ImageTask:
+    return ImageTask(prepare(CalibrateTask._request(get_preset(preset), wavelengths),
+                             local_context(None)))
+
+
+def test_a_users_mesh_is_priced_by_the_preset_it_names(tmp_path):
+    """A mesh's scene is named by its file's digest, which no calibration covers: it was
+    priced as the slowest preset (morpho, 10× the sphere), so the sky-lit default preview of a
+    small upload was predicted at 13 s on a loaded machine and refused (CI, 2026-12-03)."""
+    found = model()
+    found.calibrate(json.dumps({**CALIBRATION, "timings": {
+        "sphere": [0.009, 0.033], "morpho": [0.2, 0.6]}}).encode())
+    path = tmp_path / "torus.glb"
+    path.write_bytes(mesh_bytes("glb"))
+    common = {"preset": "sphere", "width": 256, "height": 256, "environment": "none"}
+    plain = ImageTask(prepare(RenderRequest(**common), local_context(None)))
+    mesh = ImageTask(prepare(RenderRequest(**common, mesh=str(path)), local_context(None)))
+    assert mesh.label == "sphere"  # also the metrics' label: uploads cannot grow them
+    label, units, wavelengths, mesh_s, load = mesh.units()
+    assert mesh_s > 0.0
+    assert found.predict(*mesh.units()) == pytest.approx(
+        found.predict(*plain.units()) + 1.5 * mesh_s)
+
+
+def test_a_mesh_under_an_environment_its_preset_was_not_timed_with_pays_the_slowest_load():
+    found = model()
+    found.calibrate(json.dumps({**CALIBRATION, "cold_s": {"sphere": 0.02, "soap-bubble": 0.6}}
+                               ).encode())
+    sky = ImageTask(prepare(RenderRequest(preset="sphere", environment="sky", width=64,
+                                          height=64), local_context(None)))
+    assert sky.cold_label() is None
+    assert found.predict_task(sky) == pytest.approx(found.predict(*sky.units()) + 1.5 * 0.6)
+    own = _calibration_task("soap-bubble")  # lit by the studio, as it was calibrated
+    assert own.cold_label() == "soap-bubble"
+
+
+def test_a_preset_timed_under_its_environment_is_not_charged_for_it_twice():
+    """Morpho's calibration renders it under its studio, so its timing holds the studio's
+    light equivalents already; before, they multiplied it again (morpho's standard 1024²,
+    1.8 s, predicted at 24.6 s and refused under the 10 s deadline)."""
+    tasks = [_calibration_task("morpho", w) for w in (0, 16)]
+    assert min(task.light_load() for task in tasks) > 1.0  # the studio, in lights
+    found = model()
+    found.calibrate(json.dumps({**CALIBRATION, "timings": {"morpho": [0.1, 0.3]},
+                                "light_load": {"morpho": min(t.light_load() for t in tasks)}}).encode())
+    assert found.predict(*tasks[0].units()) <= 1.5 * 0.1 * 1.01
+    brighter = ImageTask(prepare(CalibrateTask._request(get_preset("morpho"), 0).model_copy(
+        update={"environment_lights": 64}), local_context(None)))
+    assert found.predict(*brighter.units()) > 1.5 * 0.1 * 1.5  # more than it was timed with
 
 
 # Legal requests over every cost driver (size, samples, wavelengths, grating orders,

@@ -49,6 +49,10 @@ class Prepared:
     preset: Preset  # the scene drawn: the mesh preset when the request names a mesh
     job: Job
     key: str
+    # The preset the request names, also under a mesh (whose preset is named by the file's
+    # digest): what the workers' cost model was calibrated on, and its name a metric's
+    # label, from a set that uploads cannot grow.
+    named: Preset
 
     def query(self) -> dict[str, str]:
         """The canonical GET query's fields, spelled, without ``rev``."""
@@ -62,13 +66,13 @@ class Prepared:
         return replace(self, job=job, key=job.cache_key(self.preset.scene_key()))
 
 
-def scene(request: RenderRequest, context: Context) -> Preset:
-    """The preset a request draws (its mesh's, if it names one), after checking that its
-    environment exists: names are the built-ins plus the files of a folder, which the schema
-    cannot list, so an unknown one is refused like an unknown preset."""
-    preset = get_preset(request.preset)
+def scene(request: RenderRequest, named: Preset, context: Context) -> Preset:
+    """The preset a request draws (``named``, or its mesh's if it names one), after checking
+    that its environment exists: names are the built-ins plus the files of a folder, which
+    the schema cannot list, so an unknown one is refused like an unknown preset."""
+    preset = named
     if request.mesh is not None:
-        preset = context.meshes(request, preset)
+        preset = context.meshes(request, named)
     if request.environment is not None and context.check_environments:
         try:
             check_name(request.environment, context.environments_dir)
@@ -78,7 +82,8 @@ def scene(request: RenderRequest, context: Context) -> Preset:
 
 
 def prepare(request: RenderRequest, context: Context) -> Prepared:
-    preset = scene(request, context)
+    named = get_preset(request.preset)
+    preset = scene(request, named, context)
     job = resolve(request, preset)
     check_limits(job, context.limits)
-    return Prepared(request, preset, job, job.cache_key(preset.scene_key()))
+    return Prepared(request, preset, job, job.cache_key(preset.scene_key()), named)

@@ -8,11 +8,16 @@ fitted from ``CalibrateTask``'s timings, measured in a worker at start-up. ``uni
 is pixels × samples, times the material's shading cost over its preset's own
 (``shading_index``: a grating's orders); ``growth`` is how much a wavelength
 costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
-``extra`` is a task's own seconds (a mesh file's parse and its triangles).
+``extra`` is a task's own seconds (a mesh file's parse and its triangles). ``units``
+grow with what a sample shades (an environment's light equivalents over the preset's
+lights) past what its label's calibration shaded.
+A user's mesh is priced by the preset its request names (its material and lights),
+plus its file's parse and triangles in ``extra``.
 A task whose variant (``ImageTask.variant``: its program and scene) no worker has
 rendered yet also pays ``cold``, its label's first render over its second at
 calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,
-up to 0.9 s where an environment map is loaded; more than a small image's render).
+up to 0.9 s where an environment map is loaded; more than a small image's render),
+or the slowest label's where the job loads a map its label's calibration did not.
 Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
@@ -68,6 +73,9 @@ class CostModel:
     calibration_wavelengths: int = 16
     labels: dict[str, Coefficients] = field(default_factory=dict)
     cold: dict[str, float] = field(default_factory=dict)
+    # What each label's calibration shaded a sample (``ImageTask.light_load``): a preset lit
+    # by an environment was timed with it, which a job's own must not add again.
+    light_load: dict[str, float] = field(default_factory=dict)
     calibrated: bool = False
     _warm: OrderedDict[Hashable, None] = field(default_factory=OrderedDict, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
@@ -80,9 +88,11 @@ class CostModel:
         if variant is None:
             return self.predict(*units)
         key = variant()  # outside the lock: it reads the whole material
+        label = task.cold_label()
         with self._lock:
             cold = key not in self._warm
-            cold_s = self.cold.get(units[0], max(self.cold.values(), default=DEFAULT_COLD_S))
+            slowest = max(self.cold.values(), default=DEFAULT_COLD_S)
+            cold_s = slowest if label is None else self.cold.get(label, slowest)
         return self.predict(*units) + (SAFETY * cold_s if cold else 0.0)
 
     def warmed(self, task: Any) -> None:
@@ -97,12 +107,15 @@ class CostModel:
             while len(self._warm) > WARM_VARIANTS:
                 self._warm.popitem(last=False)
 
-    def predict(self, label: str, units: float, wavelengths: int, extra_s: float = 0.0) -> float:
-        """Predicted seconds for a task (safety factor included)."""
+    def predict(self, label: str, units: float, wavelengths: int, extra_s: float = 0.0,
+                light_load: float = 1.0) -> float:
+        """Predicted seconds for a task (safety factor included); ``light_load``: what a
+        sample shades over its preset's lights, scaling the units past the calibration's."""
         if label == CHECK_LABEL:
             return check_cost_s(units)
         with self._lock:
             found = self.labels.get(label) or self._slowest()
+            units *= max(1.0, light_load / self.light_load.get(label, 1.0))
         growth = (1.0 + wavelengths / GROWTH_W) / (1.0 + self.calibration_wavelengths / GROWTH_W)
         spectral = found.per_wavelength * wavelengths * growth
         return SAFETY * (self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral))
@@ -126,9 +139,10 @@ class CostModel:
             extra = max(spectral - overhead, 0.2 * spectral) / (per_unit * units) - 1.0
             labels[label] = Coefficients(per_unit, max(extra, 0.0) / wavelengths)
         cold = {label: max(0.0, float(s)) for label, s in data.get("cold_s", {}).items()}
+        loads = {label: max(1.0, float(n)) for label, n in data.get("light_load", {}).items()}
         with self._lock:
             self.overhead_s, self.labels, self.calibrated = overhead, labels, True
-            self.cold = cold
+            self.cold, self.light_load = cold, loads
             self.calibration_wavelengths = int(wavelengths)
 
     def describe(self) -> dict[str, object]:

@@ -21,6 +21,7 @@ from opaline.output.encode import encode_mdf
 from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared, prepare
 from opaline.pipeline.produce import produce
+from opaline.scene.environments import NO_ENVIRONMENT
 from opaline.workers.admission import mesh_cost_s, shading_index
 
 StopCheck = Callable[[], bool]
@@ -58,7 +59,17 @@ class ImageTask:
 
     @property
     def label(self) -> str:
-        return self.prepared.preset.name
+        """The preset the request names, a user's mesh or not: the cost model's label (it
+        was calibrated on that preset's material and lights) and the metrics'."""
+        return self.prepared.named.name
+
+    def cold_label(self) -> str | None:
+        """The label whose first render at calibration (its compile, its scene) stands for
+        this variant's: the named preset's, unless the job loads an environment map that
+        preset's calibration did not (a user's mesh is lit by the sky unless told)."""
+        own = self.prepared.named.defaults.environment
+        calibrated = None if own == NO_ENVIRONMENT else own
+        return self.label if self.prepared.job.environment == calibrated else None
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         return produce(self.prepared, renderer, should_stop)
@@ -78,11 +89,9 @@ class ImageTask:
                 job.environment, job.environment_lights, job.environment_samples,
                 job.environment_background, material)
 
-    def units(self) -> tuple[str, float, int, float]:
+    def units(self) -> tuple[str, float, int, float, float]:
         job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
-        if job.environment:  # calibrated on the preset's lights: the environment's in lights
-            units *= max(1.0, light_equivalents(job) / len(preset.lights))
         # Calibrated on the preset's own material: a costlier source or more orders scale
         # it up (never down: the calibration is the floor).
         own = preset_fields(preset)
@@ -93,7 +102,15 @@ class ImageTask:
                                      own.get("grating_orders") or 3,
                                      own.get("film_stack_pairs") or 0,
                                      (own.get("coat_weight") or 0.0) > 0.0))
-        return preset.name, units, job.wavelengths, self._mesh_s()
+        return self.label, units, job.wavelengths, self._mesh_s(), self.light_load()
+
+    def light_load(self) -> float:
+        """What a sample shades over its preset's own lights: 1, or an environment's light
+        equivalents over them (the cost model divides it by its label calibration's)."""
+        job = self.prepared.job
+        if not job.environment:
+            return 1.0
+        return light_equivalents(job) / len(self.prepared.preset.lights)
 
     def _mesh_s(self) -> float:
         args = self.prepared.preset.geometry.args
@@ -143,30 +160,31 @@ class CalibrateTask:
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         timings: dict[str, list[float]] = {}
         cold: dict[str, float] = {}
+        loads: dict[str, float] = {}
         for name, preset in all_presets().items():
-            both = [self._time(renderer, preset, w, should_stop)
-                    for w in (0, CALIBRATION_WAVELENGTHS)]
+            tasks = [ImageTask(prepare(self._request(preset, w), PRIVATE))
+                     for w in (0, CALIBRATION_WAVELENGTHS)]
+            both = [self._time_task(renderer, task, should_stop) for task in tasks]
             timings[name] = [warm for _, warm in both]
             cold[name] = max(first - warm for first, warm in both)
+            loads[name] = min(task.light_load() for task in tasks)
         tiny = RenderRequest(width=16, height=16, samples=1, wavelengths=0, quality="draft")
-        overhead = self._time_job(renderer, tiny, should_stop)[1]
+        overhead = self._time_task(renderer, ImageTask(prepare(tiny, PRIVATE)), should_stop)[1]
         units = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
         return json.dumps({"overhead_s": overhead, "units": units,
                            "wavelengths": CALIBRATION_WAVELENGTHS, "timings": timings,
-                           "cold_s": cold}).encode()
-
-    def _time(self, renderer: Any, preset: Preset, wavelengths: int, should_stop: StopCheck
-              ) -> tuple[float, float]:
-        request = RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
-                                height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
-                                wavelengths=wavelengths)
-        return self._time_job(renderer, request, should_stop)
+                           "cold_s": cold, "light_load": loads}).encode()
 
     @staticmethod
-    def _time_job(renderer: Any, request: RenderRequest, should_stop: StopCheck
-                  ) -> tuple[float, float]:
+    def _request(preset: Preset, wavelengths: int) -> RenderRequest:
+        return RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
+                             height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
+                             wavelengths=wavelengths)
+
+    @staticmethod
+    def _time_task(renderer: Any, task: ImageTask, should_stop: StopCheck
+                   ) -> tuple[float, float]:
         """Seconds of the variant's first render (its compile, its scene) and of the next."""
-        task = ImageTask(prepare(request, PRIVATE))
         seconds = []
         for _ in range(2):
             start = time.perf_counter()
