@@ -12,12 +12,13 @@ costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
 grow with what a sample shades (an environment's light equivalents over the preset's
 lights) past what its label's calibration shaded.
 A user's mesh is priced by the preset its request names (its material and lights),
-plus its file's parse and triangles in ``extra``.
+plus its file's parse and triangles in ``extra``; a job under an environment on a preset
+lit by its own lights, by that preset's timing under the sky (``ImageTask.cost_label``).
 A task whose variant (``ImageTask.variant``: its program and scene) no worker has
 rendered yet also pays ``cold``, its label's first render over its second at
 calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,
 up to 0.9 s where an environment map is loaded; more than a small image's render),
-or the slowest label's where the job loads a map its label's calibration did not.
+or the slowest label's where the job reads a map from a file.
 Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is

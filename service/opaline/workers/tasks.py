@@ -21,7 +21,7 @@ from opaline.output.encode import encode_mdf
 from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared, prepare
 from opaline.pipeline.produce import produce
-from opaline.scene.environments import NO_ENVIRONMENT
+from opaline.scene.environments import BUILTIN, MESH_ENVIRONMENT
 from opaline.workers.admission import mesh_cost_s, shading_index
 
 StopCheck = Callable[[], bool]
@@ -59,17 +59,25 @@ class ImageTask:
 
     @property
     def label(self) -> str:
-        """The preset the request names, a user's mesh or not: the cost model's label (it
-        was calibrated on that preset's material and lights) and the metrics'."""
+        """The preset the request names, a user's mesh or not (the metrics' label)."""
         return self.prepared.named.name
+
+    def cost_label(self) -> str:
+        """The calibrated label the job is priced by: the named preset's, or the same preset
+        timed under an environment where the job has one and the preset's own lights were
+        timed (a user's mesh is lit by the sky unless told otherwise)."""
+        job = self.prepared.job
+        if job.environment and not self.prepared.named.defaults.environment:
+            return self.label + UNDER_ENVIRONMENT
+        return self.label
 
     def cold_label(self) -> str | None:
         """The label whose first render at calibration (its compile, its scene) stands for
-        this variant's: the named preset's, unless the job loads an environment map that
-        preset's calibration did not (a user's mesh is lit by the sky unless told)."""
-        own = self.prepared.named.defaults.environment
-        calibrated = None if own == NO_ENVIRONMENT else own
-        return self.label if self.prepared.job.environment == calibrated else None
+        this variant's; None where the job loads a map no calibration did (a file's)."""
+        job, own = self.prepared.job, self.prepared.named.defaults.environment
+        if job.environment in (None, own) or job.environment in BUILTIN:
+            return self.cost_label()
+        return None
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
         return produce(self.prepared, renderer, should_stop)
@@ -102,7 +110,7 @@ class ImageTask:
                                      own.get("grating_orders") or 3,
                                      own.get("film_stack_pairs") or 0,
                                      (own.get("coat_weight") or 0.0) > 0.0))
-        return self.label, units, job.wavelengths, self._mesh_s(), self.light_load()
+        return self.cost_label(), units, job.wavelengths, self._mesh_s(), self.light_load()
 
     def light_load(self) -> float:
         """What a sample shades over its preset's own lights: 1, or an environment's light
@@ -153,7 +161,10 @@ CALIBRATION_WAVELENGTHS = 16
 class CalibrateTask:
     """Time each preset at 0 and ``CALIBRATION_WAVELENGTHS`` wavelengths (after a warm-up
     render of the same variant, so compile time is not counted), and what that first render
-    cost more (``cold_s``: the compile, the scene); answers JSON."""
+    cost more (``cold_s``: the compile, the scene); a preset lit by its own lights also
+    under the sky (label ``<name>+environment``), as light equivalents bound an
+    environment's cost from above only (the sky measured 0.6-1.9× the key light where they
+    counted 2-5×); answers JSON."""
 
     label: str = "calibration"
 
@@ -161,13 +172,13 @@ class CalibrateTask:
         timings: dict[str, list[float]] = {}
         cold: dict[str, float] = {}
         loads: dict[str, float] = {}
-        for name, preset in all_presets().items():
-            tasks = [ImageTask(prepare(self._request(preset, w), PRIVATE))
+        for label, preset, environment in calibrated_labels():
+            tasks = [ImageTask(prepare(self._request(preset, w, environment), PRIVATE))
                      for w in (0, CALIBRATION_WAVELENGTHS)]
             both = [self._time_task(renderer, task, should_stop) for task in tasks]
-            timings[name] = [warm for _, warm in both]
-            cold[name] = max(first - warm for first, warm in both)
-            loads[name] = min(task.light_load() for task in tasks)
+            timings[label] = [warm for _, warm in both]
+            cold[label] = max(first - warm for first, warm in both)
+            loads[label] = min(task.light_load() for task in tasks)
         tiny = RenderRequest(width=16, height=16, samples=1, wavelengths=0, quality="draft")
         overhead = self._time_task(renderer, ImageTask(prepare(tiny, PRIVATE)), should_stop)[1]
         units = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
@@ -176,10 +187,11 @@ class CalibrateTask:
                            "cold_s": cold, "light_load": loads}).encode()
 
     @staticmethod
-    def _request(preset: Preset, wavelengths: int) -> RenderRequest:
+    def _request(preset: Preset, wavelengths: int, environment: str | None = None
+                 ) -> RenderRequest:
         return RenderRequest(preset=preset.name, width=CALIBRATION_SIZE,
                              height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
-                             wavelengths=wavelengths)
+                             wavelengths=wavelengths, environment=environment)
 
     @staticmethod
     def _time_task(renderer: Any, task: ImageTask, should_stop: StopCheck
@@ -193,8 +205,22 @@ class CalibrateTask:
         return seconds[0], seconds[1]
 
     def units(self) -> tuple[str, float, int]:
-        """Four renders per preset (a warm-up and a timing at each of two wavelength
+        """Four renders per label (a warm-up and a timing at each of two wavelength
         counts), half of them spectral: so admission counts the work ahead of a request."""
         per_render = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
-        return ("calibration", 4.0 * len(all_presets()) * per_render,
+        return ("calibration", 4.0 * len(calibrated_labels()) * per_render,
                 CALIBRATION_WAVELENGTHS // 2)
+
+
+UNDER_ENVIRONMENT = "+environment"
+
+
+def calibrated_labels() -> list[tuple[str, Preset, str | None]]:
+    """(label, preset, environment) of every calibration: each preset as it is, and each
+    preset lit by its own lights also under the sky."""
+    labels: list[tuple[str, Preset, str | None]] = []
+    for name, preset in all_presets().items():
+        labels.append((name, preset, None))
+        if not preset.defaults.environment:
+            labels.append((name + UNDER_ENVIRONMENT, preset, MESH_ENVIRONMENT))
+    return labels
