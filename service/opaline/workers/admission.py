@@ -11,9 +11,9 @@ costs more past the calibrated 16 (measured on llvmpipe: 1.0-1.8× at 128);
 ``extra`` is a task's own seconds (a mesh file's parse and its triangles). ``units``
 grow with what a sample shades (an environment's light equivalents over the preset's
 lights) past what its label's calibration shaded.
-A user's mesh is priced by the preset its request names (its material and lights),
-plus its file's parse and triangles in ``extra``; a job under an environment on a preset
-lit by its own lights, by that preset's timing under the sky (``ImageTask.cost_label``).
+A user's mesh is priced by the preset its request names (its material and lights); a
+job under an environment on a preset lit by its own lights, by that preset's timing
+under the sky (``ImageTask.cost_label``).
 A task whose variant (``ImageTask.variant``: its program and scene) no worker has
 rendered yet also pays ``cold``, its label's first render over its second at
 calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,

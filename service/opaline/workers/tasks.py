@@ -66,8 +66,7 @@ class ImageTask:
         """The calibrated label the job is priced by: the named preset's, or the same preset
         timed under an environment where the job has one and the preset's own lights were
         timed (a user's mesh is lit by the sky unless told otherwise)."""
-        job = self.prepared.job
-        if job.environment and not self.prepared.named.defaults.environment:
+        if self.prepared.job.environment and lit_by_own_lights(self.prepared.named):
             return self.label + UNDER_ENVIRONMENT
         return self.label
 
@@ -160,6 +159,7 @@ CALIBRATION_WAVELENGTHS = 16
 # 28.5 s where it took 7-9 s (llvmpipe, 2 cores), and a fresh server's first client was
 # told to wait that long. Half (14.2 s) still waits past the time taken.
 CALIBRATION_SHARE = 0.5
+UNDER_ENVIRONMENT = "+environment"  # the label of a preset's calibration under the sky
 
 
 @dataclass(frozen=True)
@@ -217,7 +217,9 @@ class CalibrateTask:
                 CALIBRATION_WAVELENGTHS // 2)
 
 
-UNDER_ENVIRONMENT = "+environment"
+def lit_by_own_lights(preset: Preset) -> bool:
+    """A preset whose defaults name no environment: calibrated under the sky as well."""
+    return not preset.defaults.environment
 
 
 def calibrated_labels() -> list[tuple[str, Preset, str | None]]:
@@ -226,6 +228,6 @@ def calibrated_labels() -> list[tuple[str, Preset, str | None]]:
     labels: list[tuple[str, Preset, str | None]] = []
     for name, preset in all_presets().items():
         labels.append((name, preset, None))
-        if not preset.defaults.environment:
+        if lit_by_own_lights(preset):
             labels.append((name + UNDER_ENVIRONMENT, preset, MESH_ENVIRONMENT))
     return labels
