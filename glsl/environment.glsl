@@ -27,6 +27,11 @@ void main() {
     float elevation = asin(clamp(d.y, -1.0, 1.0));
     vec2 uv = vec2(fract(azimuth / TWO_PI), 0.5 + elevation / PI);
     // Explicit LOD: the azimuth's wrap would otherwise pick a tiny mip along the seam.
-    frag_color = vec4(textureLod(u_environment, uv, u_lod).rgb * u_intensity, 1.0);
+    // The map is sampled one level at a time (LINEAR_MIPMAP_NEAREST, for the surface's
+    // lobe reads): the blur between two levels is mixed here, as trilinear would.
+    float level = floor(u_lod);
+    vec3 below = textureLod(u_environment, uv, level).rgb;
+    vec3 above = textureLod(u_environment, uv, level + 1.0).rgb;
+    frag_color = vec4(mix(below, above, u_lod - level) * u_intensity, 1.0);
 }
 #endif

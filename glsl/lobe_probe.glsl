@@ -7,7 +7,8 @@
 // environment_specular in the frame (n = a, t = b) toward v = c: (rgb, 1); 5 sample
 // k = a.x of env_sequence shifted by b; 6 specular_envelope at n = a toward v = c (the
 // ENV_ENVELOPE variant); 7 multipeak_band_cell at h = a.xy over a cell of side b.x;
-// 8 one pass of environment_coat in the frame (n = a, t = b) toward v = c (COAT).
+// 8 one pass of environment_coat in the frame (n = a, t = b) toward v = c (COAT);
+// 9 env_lookup toward a (the map's frame) at level b.x, in pass c.x.
 // Mode 0 needs the A-S variant (u_ex, u_ey), 7 the multi-peak one.
 #include "fullscreen.glsl"
 
@@ -44,6 +45,9 @@ void main() {
         frag_color = vec4(environment_specular(mat, env, shading_frame(a, b), c, -1.0), 1.0);
     } else if (u_mode == 5) {
         frag_color = vec4(env_sequence(int(a.x), b), 1.0);
+    } else if (u_mode == 9) {
+        env.pass = int(c.x);
+        frag_color = vec4(env_lookup(env, a, b.x), 1.0);
     }
 #ifdef ENV_ENVELOPE
     if (u_mode == 6) {

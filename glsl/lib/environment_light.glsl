@@ -41,11 +41,39 @@ vec3 env_to_map(Environment env, vec3 d) {
     return vec3(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
 }
 
+// The fragment's next draw in [0, 1) for choosing a read's level (env_level); below 0
+// until the first read sets it from the pixel's hash and the pass.
+float g_env_level_draw = -1.0;
+
+// A pixel's own value in [0, 1), independent of env_pixel_shift's three (other constants).
+float env_pixel_dither() {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = p.x * 7919u + p.y * 104729u + 15485863u;
+    h = (h ^ (h >> 15)) * 0x2c1b3c6du;
+    h = (h ^ (h >> 12)) * 0x297a2d39u;
+    h ^= h >> 15;
+    return float(h >> 8) / 16777216.0;
+}
+
+// The level a read takes, floor(lod) or the next, the upper with probability fract(lod):
+// in expectation the trilinear read, at one level's bilinear cost (the map is sampled
+// LINEAR_MIPMAP_NEAREST, gl/environment_maps.py). A trilinear read cost llvmpipe as much
+// as the rest of a lobe sample (bench/speed_env.py). The draws step by 1/φ from the
+// pixel's own start, so a pixel's reads spread over [0, 1).
+float env_level(Environment env, float lod) {
+    if (g_env_level_draw < 0.0) {
+        g_env_level_draw = fract(env_pixel_dither() + float(env.pass) * 0.7548776662);
+    }
+    float level = floor(lod + g_env_level_draw);
+    g_env_level_draw = fract(g_env_level_draw + 0.6180339887);
+    return level;
+}
+
 vec3 env_lookup(Environment env, vec3 m, float lod) {
     float azimuth = atan(m.z, m.x);
     float elevation = asin(clamp(m.y, -1.0, 1.0));
     vec2 uv = vec2(fract(azimuth / TWO_PI), 0.5 + elevation / PI);
-    return textureLod(u_env_map, uv, lod).rgb * env.intensity;
+    return textureLod(u_env_map, uv, env_level(env, lod)).rgb * env.intensity;
 }
 
 // log2 of the side of a solid angle in level-0 texels toward m: a level-0 texel spans

@@ -198,3 +198,46 @@ def test_rotation_map_samples_in_rgb_are_the_papers_channels(renderer, f0):
     diff = np.abs(shared - rgb)
     assert float(diff.max()) <= 1e-3 * float(rgb.max()) and float(diff.mean()) <= 1e-6
     assert not np.allclose(spectral, rgb, rtol=1e-3)  # the define is what makes them equal
+
+
+@pytest.mark.parametrize("lod", [0.25, 0.5, 0.75])
+def test_a_map_read_takes_one_level_with_trilinear_odds(renderer, tmp_path, lod):
+    """env_lookup reads one mip level, floor(lod) or the next, the upper with probability
+    fract(lod): trilinear in expectation at one bilinear read's cost. A checkerboard of 0
+    and 1 has level 1 at 0.5 everywhere, so at a level-0 texel's centre each read is the
+    texel or 0.5, and the share of 0.5 is fract(lod). (The trilinear read gave every pixel
+    the mix: it fails on the read between the two.)"""
+    import cv2
+
+    height, width = 32, 64
+    rows, cols = np.indices((height, width))
+    checker = ((rows + cols) % 2).astype(np.float32)
+    cv2.imwrite(str(tmp_path / "checker.hdr"), np.repeat(checker[..., None], 3, axis=2))
+    rng = np.random.default_rng(21)
+    count = 8192
+    i = rng.integers(0, width, count)
+    j = rng.integers(4, height - 4, count)  # away from the poles' squeezed texels
+    azimuth = TWO_PI * (i + 0.5) / width
+    elevation = ((j + 0.5) / height - 0.5) * math.pi
+    m = np.stack([np.cos(elevation) * np.cos(azimuth), np.sin(elevation),
+                  np.cos(elevation) * np.sin(azimuth)], -1)
+    maps = EnvironmentMaps(renderer.ctx, tmp_path)
+    try:
+        uploaded = maps.get("checker.hdr")
+        environment = (uploaded.texture, uploaded.irradiance)
+
+        def read(level: float) -> np.ndarray:
+            cases = (as_f32(m), as_f32(np.full((count, 3), level)), as_f32(np.zeros((count, 3))))
+            return renderer.probes.lobe(material(1.0, 1.0), "lookup", cases, environment,
+                                        brute=False)[0][:, 0].astype(np.float64)
+
+        texel = read(0.0)
+        mixed = read(lod)
+    finally:
+        maps.release()
+    assert np.all(np.minimum(np.abs(texel), np.abs(texel - 1.0)) < 1e-2)  # level 0: the texels
+    upper = np.abs(mixed - 0.5) < 1e-2
+    lower = np.abs(mixed - texel) < 1e-2
+    assert np.all(upper | lower), "a read between two levels' values: trilinear, not one level"
+    share = float(upper[np.abs(texel - 0.5) > 0.25].mean())
+    assert abs(share - lod) < 0.03, share

@@ -57,9 +57,12 @@ class EnvironmentMaps:
         texture = self.ctx.texture((width, height), 4,
                                    np.ascontiguousarray(rgba, dtype="f4").tobytes(), dtype="f4")
         # The one place the map's sampling is set: environment light (filtered
-        # importance sampling) and the backdrop's blur read this chain.
+        # importance sampling) and the backdrop's blur read this chain. One level a read:
+        # the surface picks a read's level at random with trilinear's weights (env_level
+        # in glsl/lib/environment_light.glsl), the backdrop mixes two; a trilinear read
+        # cost llvmpipe as much as the rest of a lobe sample.
         texture.build_mipmaps()
-        texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        texture.filter = (moderngl.LINEAR_MIPMAP_NEAREST, moderngl.LINEAR)
         texture.repeat_x, texture.repeat_y = True, False
         return EnvironmentMap(texture, irradiance.coefficients(radiance), directions, lights)
 

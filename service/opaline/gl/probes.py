@@ -21,7 +21,7 @@ from opaline.model.params import Material
 
 # glsl/lobe_probe.glsl's modes: what each case evaluates.
 LOBE_MODES = {"ashikhmin": 0, "disc": 1, "mixture": 2, "irradiance": 3, "specular": 4,
-              "sequence": 5, "envelope": 6, "band_cell": 7, "coat": 8}
+              "sequence": 5, "envelope": 6, "band_cell": 7, "coat": 8, "lookup": 9}
 
 
 
