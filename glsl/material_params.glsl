@@ -35,7 +35,7 @@ uniform vec2 u_stack_bin_nk[16];
 #endif
 #if (WAVELENGTHS == 0 || defined(ENV_GRATING_ORDERS)) && defined(IRIDESCENCE_GRATING)
 uniform vec3 u_visible_density[81];  // VISIBLE_TABLE of lib/grating.glsl
-uniform vec3 u_visible_cumulative[81];  // its integral from 380 nm (visible.cumulative_table)
+uniform uvec3 u_visible_cumulative[81];  // its integral from 380 nm (visible.packed_cumulative)
 #endif
 #include "lib/material.glsl"
 

@@ -29,6 +29,11 @@
 #endif
 #define EPS_K2 1e-12
 #define VISIBLE_TABLE 81  // glsl/material_params.glsl declares the table at this size
+// visible.PACKED_VALUE and PACKED_STEP: the ranges the packed table's 16 bits span.
+#define VISIBLE_VALUE_LOW -0.5
+#define VISIBLE_VALUE_SCALE (2.0 / 65535.0)
+#define VISIBLE_STEP_LOW -0.125
+#define VISIBLE_STEP_SCALE (0.25 / 65535.0)
 
 // J_m(x) by its power series (x/2)^m/m! · Σ_k (-x²/4)^k·m!/(k!(k+m)!), summed by
 // Horner from the last term: a fixed count, no early exit, so it unrolls into
@@ -149,11 +154,17 @@ vec3 visible_density(float lam) {
     return mix(u_visible_density[i], u_visible_density[i + 1], x - float(i));
 }
 
-// ∫ ŵ(λ) dλ from 380 nm to lam: the cumulative table, linear between its 5 nm points.
+// ∫ ŵ(λ) dλ from 380 nm to lam: the cumulative table, linear between its 5 nm points,
+// each point packed with its step to the next (visible.packed_cumulative): a read is one
+// gather from the uniform array, not two, and on llvmpipe the gathers are most of what a
+// grating's orders cost under an environment (docs/speed.md).
 vec3 visible_cumulative(float lam) {
     float x = clamp((lam - 380.0) / 5.0, 0.0, float(VISIBLE_TABLE - 1));
     int i = min(int(floor(x)), VISIBLE_TABLE - 2);
-    return mix(u_visible_cumulative[i], u_visible_cumulative[i + 1], x - float(i));
+    uvec3 point = u_visible_cumulative[i];
+    vec3 value = vec3(point >> 16u) * VISIBLE_VALUE_SCALE + VISIBLE_VALUE_LOW;
+    vec3 step = vec3(point & 0xffffu) * VISIBLE_STEP_SCALE + VISIBLE_STEP_LOW;
+    return value + (x - float(i)) * step;
 }
 
 // ŵ averaged over lam ± half (a lobe's extent in λ); the density itself under half a step.

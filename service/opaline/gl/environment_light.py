@@ -102,7 +102,7 @@ def grating_uniforms() -> Uniforms:
     """The spectrum in closed form, which a grating's orders and lights are weighted by
     under an environment read from its map, whatever the job's wavelengths."""
     return {"u_visible_density": [tuple(row) for row in visible.density_table()[1]],
-            "u_visible_cumulative": [tuple(row) for row in visible.cumulative_table()],
+            "u_visible_cumulative": visible.packed_cumulative_uniform(),
             "u_channel_nm": tuple(float(x) for x in grating.channel_wavelengths())}
 
 

@@ -191,7 +191,7 @@ def _physical_uniforms(material: Material, wavelengths: int) -> Uniforms:
         values["u_film_sens_centre"] = [tuple(g) for g in gaussians[..., 1]]
         values["u_film_sens_sigma"] = [tuple(g) for g in gaussians[..., 2]]
         values["u_visible_density"] = [tuple(row) for row in visible.density_table()[1]]
-        values["u_visible_cumulative"] = [tuple(row) for row in visible.cumulative_table()]
+        values["u_visible_cumulative"] = visible.packed_cumulative_uniform()
         values["u_channel_nm"] = tuple(float(x) for x in grating.channel_wavelengths())
     return values
 

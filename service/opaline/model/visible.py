@@ -87,14 +87,59 @@ def cumulative_table() -> np.ndarray:
     return cumulative
 
 
-def cumulative_at(lam_nm: npt.ArrayLike) -> np.ndarray:
-    """The cumulative table, linear between its points and held beyond its ends.
+# The cumulative table as the shader reads it: each point's value and the step to the next
+# in one 32-bit word a channel, 16 bits each (fixed point over these ranges; the table
+# spans -0.41 … 1.11, its steps -0.045 … 0.106). A read is then one gather from the
+# uniform array, not two: on llvmpipe the gathers are most of what a grating's orders
+# cost under an environment (docs/speed.md).
+PACKED_VALUE = (-0.5, 1.5)
+PACKED_STEP = (-0.125, 0.125)
+_PACKED_LEVELS = 65535.0
 
-    Mirrors ``visible_cumulative`` in glsl/lib/environment_grating.glsl."""
+
+def _quantised(values: np.ndarray, span: tuple[float, float]) -> np.ndarray:
+    scale = (span[1] - span[0]) / _PACKED_LEVELS
+    return np.round((values - span[0]) / scale).astype(np.uint32)
+
+
+def _dequantised(levels: np.ndarray, span: tuple[float, float]) -> np.ndarray:
+    return levels.astype(np.float64) * ((span[1] - span[0]) / _PACKED_LEVELS) + span[0]
+
+
+@lru_cache(maxsize=1)
+def packed_cumulative() -> np.ndarray:
+    """(TABLE_SIZE, 3) uint32: point i's value (high 16 bits) and the step from its
+    quantised value to point i + 1's (low 16 bits), so the line through a segment meets
+    the next point's quantised value to within a step level (4e-6). Read by
+    ``visible_cumulative`` in glsl/lib/grating.glsl; the last point's step is 0."""
+    value = _quantised(cumulative_table(), PACKED_VALUE)
+    nodes = _dequantised(value, PACKED_VALUE)
+    steps = np.concatenate([np.diff(nodes, axis=0), np.zeros((1, 3))])
+    packed: np.ndarray = (value << np.uint32(16)) | _quantised(steps, PACKED_STEP)
+    packed.setflags(write=False)
+    return packed
+
+
+def packed_cumulative_uniform() -> list[tuple[int, int, int]]:
+    """``packed_cumulative`` as the shader's ``u_visible_cumulative`` takes it."""
+    return [(int(r), int(g), int(b)) for r, g, b in packed_cumulative()]
+
+
+def cumulative_at(lam_nm: npt.ArrayLike) -> np.ndarray:
+    """The cumulative table as packed (``packed_cumulative``): a point's value plus the
+    fraction of its step, held beyond the ends; within 3.1e-5 of ``cumulative_table``
+    linear between its points.
+
+    Mirrors ``visible_cumulative`` in glsl/lib/grating.glsl."""
     grid, _ = density_table()
     lam = np.asarray(lam_nm, dtype=np.float64)
-    table = cumulative_table()
-    return np.stack([np.interp(lam, grid, table[:, c]) for c in range(3)], axis=-1)
+    packed = packed_cumulative()
+    x = np.clip((lam - RANGE_NM[0]) / TABLE_STEP_NM, 0.0, TABLE_SIZE - 1.0)
+    i = np.minimum(np.floor(x).astype(int), TABLE_SIZE - 2)
+    value = _dequantised(packed[i] >> np.uint32(16), PACKED_VALUE)
+    step = _dequantised(packed[i] & np.uint32(0xFFFF), PACKED_STEP)
+    result: np.ndarray = value + (x - i)[..., None] * step
+    return result
 
 
 def filtered_density(lam_nm: npt.ArrayLike, half_nm: npt.ArrayLike) -> np.ndarray:
