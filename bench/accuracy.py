@@ -4,6 +4,7 @@
     python bench/accuracy.py --from-results [--write-table]   # tables and plot again
     python bench/accuracy.py --presets morpho --merge [--write-table]   # one preset again
     python bench/accuracy.py --from-results --time-tiers [--presets oil-film ...]
+    python bench/accuracy.py --presets cd-rom-grating --merge-table   # the table only
 
 Per preset, a grid over samples × wavelengths × anti-aliasing (accuracy_grid.py),
 each point timed (fastest of 3 warm renders) and scored against the converged
@@ -18,6 +19,11 @@ kept), docs/accuracy.csv, docs/accuracy.png (accuracy_plot.py), and with
 --merge measures only the named presets and keeps every other preset's rows from the last
 run: valid only while the shaders are the ones that run measured (the table's test checks
 the shader hash, and each preset's own digest, so a stale merge fails there).
+--merge-table, where that run's raw results are not at hand (they are not committed),
+measures the named presets and puts their entries into the shipped table, keeping the
+others' and taking the shaders' hash now: valid only when every other preset renders as
+it did (bench/unchanged_renders.py --base REV shows it, image by image); docs/accuracy.*
+are left as they are.
 """
 
 from __future__ import annotations
@@ -62,7 +68,8 @@ def invocation() -> dict[str, str]:
             "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")}
 
 
-def run(names: list[str], size: int, variants: list[str]) -> dict:
+def run(names: list[str], size: int, variants: list[str], tiers: bool = True) -> dict:
+    """The grid's rows and facts for ``names``, and (``tiers``) each tier's time over draft."""
     from opaline.model.presets import all_presets
 
     presets = all_presets()
@@ -81,7 +88,7 @@ def run(names: list[str], size: int, variants: list[str]) -> dict:
                 rows += more
                 facts.append(found["facts"])
             print(f"{name}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
-        ratios = time_tiers(bench, names)
+        ratios = time_tiers(bench, names) if tiers else {}
     finally:
         bench.release()
     info["wall_s"] = time.perf_counter() - started
@@ -126,6 +133,9 @@ def main() -> None:
     parser.add_argument("--merge", action="store_true",
                         help="with --presets: replace those presets' rows in the last run's "
                              "results and keep the others'")
+    parser.add_argument("--merge-table", action="store_true",
+                        help="with --presets: measure them and replace only their entries in "
+                             "the shipped table (see bench/unchanged_renders.py)")
     parser.add_argument("--write-table", action="store_true",
                         help=f"also write {TABLE_PATH.relative_to(ROOT)}")
     parser.add_argument("--out", type=Path, default=DOCS, help="where accuracy.* go")
@@ -133,6 +143,9 @@ def main() -> None:
 
     from opaline.model.presets import all_presets
 
+    if args.merge_table:
+        merge_table(parser, args)
+        return
     if args.from_results:
         data = json.loads(RAW.read_text())
         if args.time_tiers:
@@ -158,6 +171,23 @@ def main() -> None:
             data = merged(last, data, names)
         write_atomic(RAW, json.dumps(data, indent=1).encode())
     write_outputs(data, args.out, args.write_table)
+
+
+def merge_table(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Measure ``args.presets`` and put their entries into the shipped table."""
+    from accuracy_table import merged_table
+    from opaline.model.auto import TABLE_PATH, VARIANTS
+
+    if not args.presets:
+        parser.error("--merge-table needs --presets: the presets to measure again")
+    shipped = json.loads(TABLE_PATH.read_text())
+    if shipped["size"] != args.size:
+        parser.error(f"--merge-table: the table is at {shipped['size']}², "
+                     f"this run would be at {args.size}²")
+    data = run(args.presets, args.size, list(VARIANTS[1:]), tiers=False)  # the table has none
+    write_atomic(TABLE_PATH, merged_table(shipped, data["rows"], data["facts"], data["info"]))
+    print(f"{', '.join(args.presets)}: measured in {data['info']['wall_s']:.0f} s; "
+          f"their entries in {TABLE_PATH.relative_to(ROOT)} replaced")
 
 
 def last_run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> dict:

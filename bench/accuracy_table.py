@@ -12,10 +12,34 @@ import json
 
 
 def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
+    from opaline.resources import sources_digest
+
+    table = {"command": "python bench/accuracy.py --write-table", "date": info["date"],
+             "size": info["size"], "shaders": sources_digest(), "machine": info["cpu"],
+             "presets": preset_entries(rows, facts, info)}
+    return (compact(table) + "\n").encode()
+
+
+def merged_table(old: dict, rows: list[dict], facts: list[dict], info: dict) -> bytes:
+    """``old`` (the shipped table) with the measured presets' entries in place of theirs and
+    the shaders' hash now: valid only where every other preset renders as it did when
+    measured (bench/unchanged_renders.py says whether it does). The merge is noted."""
+    from opaline.resources import sources_digest
+
+    entries = preset_entries(rows, facts, info)
+    earlier = [m for m in old.get("merged", []) if not set(m["presets"]) <= set(entries)]
+    table = {**old, "shaders": sources_digest(),
+             "presets": {**old["presets"], **entries},
+             "merged": [*earlier, {"command": info["command"], "date": info["date"],
+                                   "presets": sorted(entries)}]}
+    return (compact(table) + "\n").encode()
+
+
+def preset_entries(rows: list[dict], facts: list[dict], info: dict) -> dict[str, dict]:
+    """Per preset measured: its hash, the points and each material variant's errors."""
     from opaline.model.auto import difficulty, preset_digest
     from opaline.model.params import Material
     from opaline.model.presets import get_preset
-    from opaline.resources import sources_digest
 
     presets = {}
     for preset in dict.fromkeys(r["preset"] for r in rows):
@@ -45,10 +69,7 @@ def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
                         "ms": round(base[k]["ms"], 2)} for k in points],
             "materials": materials,
         }
-    table = {"command": "python bench/accuracy.py --write-table", "date": info["date"],
-             "size": info["size"], "shaders": sources_digest(), "machine": info["cpu"],
-             "presets": presets}
-    return (compact(table) + "\n").encode()
+    return presets
 
 
 def compact(value, indent: str = "") -> str:
