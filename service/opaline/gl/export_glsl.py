@@ -37,7 +37,13 @@ def _literal(kind: str, value: object) -> str:
     """A scalar or a vector (material_program gives each vector as a tuple) as GLSL."""
     kind = GLSL_TYPES.get(kind, kind)
     if isinstance(value, tuple):
-        parts = ", ".join(repr(float(x)) for x in value)
+        # Integer vectors as integers: a float literal keeps 24 bits, and the packed tables
+        # (visible.packed_cumulative) use all 32.
+        if kind.startswith(("ivec", "uvec")):
+            suffix = "u" if kind.startswith("u") else ""
+            parts = ", ".join(f"{int(x)}{suffix}" for x in value)
+        else:
+            parts = ", ".join(repr(float(x)) for x in value)
         return f"{kind}({parts})"
     if not isinstance(value, int | float):
         raise TypeError(f"a {kind} uniform given {value!r}")
