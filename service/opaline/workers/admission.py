@@ -18,7 +18,12 @@ A task whose variant (``ImageTask.variant``: its program and scene) no worker ha
 rendered yet also pays ``cold``, its label's first render over its second at
 calibration: the program's compile and the scene's build (0.01-0.04 s on llvmpipe,
 up to 0.9 s where an environment map is loaded; more than a small image's render),
-or the slowest label's where the job reads a map from a file.
+or the slowest label's where the job reads a map from a file. Mesa's shader cache on
+disk makes a compile it holds nearly free (the sphere under the studio, A-S MDF, 512²: a
+first render in 0.07 s with its program there, 0.41-0.45 s without): a server started
+with the calibration's programs in that cache and a request's not undercounts that
+request's compile. A fresh deployment (the Dockerfile's) starts with
+the cache empty, so its calibration measures real compiles.
 Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
