@@ -189,7 +189,6 @@ def test_cli_verbose_says_what_auto_picked(tmp_path):
     assert out.exists()
 
 
-
 def test_own_material_keeps_a_tenth_to_spare():
     """A point measured just under the budget on the material itself is passed over: against
     another converged reference its error moves by a few thousandths (tempered-steel's pick

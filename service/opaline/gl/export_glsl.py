@@ -33,27 +33,37 @@ vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v) {
 """
 
 
-def _literal(kind: str, value: object) -> str:
-    """A scalar or a vector (material_program gives each vector as a tuple) as GLSL."""
-    kind = GLSL_TYPES.get(kind, kind)
-    if isinstance(value, tuple):
-        # Integer vectors as integers: a float literal keeps 24 bits, and the packed tables
-        # (visible.packed_cumulative) use all 32.
-        if kind.startswith(("ivec", "uvec")):
-            suffix = "u" if kind.startswith("u") else ""
-            parts = ", ".join(f"{int(x)}{suffix}" for x in value)
-        else:
-            parts = ", ".join(repr(float(x)) for x in value)
-        return f"{kind}({parts})"
+def _element_kind(kind: str) -> str:
+    """The scalar type of a vector's (or matrix's) components; a scalar's own type."""
+    for prefix, element in (("ivec", "int"), ("uvec", "uint"), ("bvec", "bool")):
+        if kind.startswith(prefix):
+            return element
+    return "float" if kind.startswith(("vec", "mat")) else kind
+
+
+def _scalar(kind: str, value: object) -> str:
     if not isinstance(value, int | float):
         raise TypeError(f"a {kind} uniform given {value!r}")
     if kind == "float":
         return repr(float(value))  # repr keeps every digit of the double
-    if kind in ("int", "uint"):
+    # Integers as integers: a float literal keeps 24 bits, and the packed tables
+    # (visible.packed_cumulative) use all 32. GLSL 3.30 converts no int to a uint.
+    if kind == "int":
         return str(int(value))
+    if kind == "uint":
+        return f"{int(value)}u"
     if kind == "bool":
         return "true" if value else "false"
     raise TypeError(f"a {kind} uniform given the scalar {value!r}")
+
+
+def _literal(kind: str, value: object) -> str:
+    """A scalar or a vector (material_program gives each vector as a tuple) as GLSL."""
+    kind = GLSL_TYPES.get(kind, kind)
+    if isinstance(value, tuple):
+        element = _element_kind(kind)
+        return f"{kind}({', '.join(_scalar(element, x) for x in value)})"
+    return _scalar(kind, value)
 
 
 def _constant(match: re.Match[str], values: Mapping[str, UniformValue]) -> str:
