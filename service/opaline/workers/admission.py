@@ -22,8 +22,8 @@ or the slowest label's where the job reads a map from a file. Mesa's shader cach
 disk makes a compile it holds nearly free (the sphere under the studio, A-S MDF, 512²: a
 first render in 0.07 s with its program there, 0.41-0.45 s without): a server started
 with the calibration's programs in that cache and a request's not undercounts that
-request's compile. A fresh deployment (the Dockerfile's) starts with
-the cache empty, so its calibration measures real compiles.
+request's compile. A new container from the Dockerfile starts with the cache empty, so
+its calibration measures real compiles; a restarted one keeps the cache in its home.
 Until those arrive, and for labels the calibration did not cover, the slowest
 calibrated label (or a conservative built-in guess) stands in, and every
 prediction carries a safety factor: refusing a job that would have made it is
