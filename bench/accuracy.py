@@ -175,6 +175,7 @@ def main() -> None:
 
 def merge_table(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     """Measure ``args.presets`` and put their entries into the shipped table."""
+    from accuracy_grid import fit_times
     from accuracy_table import merged_table
     from opaline.model.auto import TABLE_PATH, VARIANTS
 
@@ -185,6 +186,9 @@ def merge_table(parser: argparse.ArgumentParser, args: argparse.Namespace) -> No
         parser.error(f"--merge-table: the table is at {shipped['size']}², "
                      f"this run would be at {args.size}²")
     data = run(args.presets, args.size, list(VARIANTS[1:]), tiers=False)  # the table has none
+    # Ranked by the cost model fitted to their times, as a full run's entries are
+    # (write_outputs): one point's fastest-of-3 scatters by 10-50 % on a shared machine.
+    data["info"]["time_model"] = fit_times(data["rows"])
     write_atomic(TABLE_PATH, merged_table(shipped, data["rows"], data["facts"], data["info"]))
     print(f"{', '.join(args.presets)}: measured in {data['info']['wall_s']:.0f} s; "
           f"their entries in {TABLE_PATH.relative_to(ROOT)} replaced")
