@@ -17,13 +17,16 @@ Writes docs/accuracy.md (accuracy_report.py; the hand-written GUIDE section is
 kept), docs/accuracy.csv, docs/accuracy.png (accuracy_plot.py), and with
 --write-table the table quality=auto reads, service/opaline/model/quality_table.json.
 --merge measures only the named presets and keeps every other preset's rows from the last
-run: valid only while the shaders are the ones that run measured (the table's test checks
-the shader hash, and each preset's own digest, so a stale merge fails there).
---merge-table, where that run's raw results are not at hand (they are not committed),
+run. --merge-table, where that run's raw results are not at hand (they are not committed),
 measures the named presets and puts their entries into the shipped table, keeping the
-others' and taking the shaders' hash now: valid only when every other preset renders as
-it did (bench/unchanged_renders.py --base REV shows it, image by image); docs/accuracy.*
-are left as they are.
+others'; docs/accuracy.* are left as they are. Either is valid only for the presets whose
+entries still describe what renders: each entry is stamped with its preset's hash and with
+the program variants its measurement compiled (references included), hashed as they
+compile (gl/variant_source.py: comments and branches they skip do not count), and
+tests/model/test_auto.py names every preset whose stamp no longer matches. A change in
+Python that the stamps do not see is what bench/unchanged_renders.py --base REV shows.
+Every entry ranks its points by a cost model fitted to their measured times (fit_times),
+in a merge as in a full run.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 # Runnable as a script from a checkout: the bench's modules and the service package.
 sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "service")]
-from accuracy_grid import Bench, measure, paired_ratios  # noqa: E402
+from accuracy_grid import Bench, measure, measured_programs, paired_ratios  # noqa: E402
 from opaline.output.files import write_atomic  # noqa: E402
 
 DOCS = ROOT / "docs"
@@ -75,7 +78,8 @@ def run(names: list[str], size: int, variants: list[str], tiers: bool = True) ->
     presets = all_presets()
     started = time.perf_counter()
     bench = Bench(size)
-    info = {**machine(bench), "size": size, "load": [os.getloadavg()[0]], **invocation()}
+    info = {**machine(bench), "size": size, "load": [os.getloadavg()[0]], **invocation(),
+            "programs": {}}
     rows, facts = [], []
     try:
         for name in names:
@@ -87,6 +91,7 @@ def run(names: list[str], size: int, variants: list[str], tiers: bool = True) ->
                 more, found = measure(bench, presets[name], variant, base["times"])
                 rows += more
                 facts.append(found["facts"])
+            info["programs"][name] = measured_programs(bench, presets[name])
             print(f"{name}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
         ratios = time_tiers(bench, names) if tiers else {}
     finally:
@@ -215,7 +220,9 @@ def merged(old: dict, new: dict, names: list[str]) -> dict:
     keep = set(names)
     earlier = [m for m in old["info"].get("merged", [])
                if not ("presets" in m and set(m["presets"]) <= keep)]
-    info = {**old["info"], "merged": [*earlier, {
+    info = {**old["info"], "programs": {**old["info"].get("programs", {}),
+                                        **new["info"]["programs"]},
+            "merged": [*earlier, {
         **{key: new["info"][key] for key in ("command", "date", "wall_s", "load")},
         "presets": sorted(keep)}]}
     return {"info": info,

@@ -38,11 +38,11 @@ def grid(mdf: str, wavelengths=WAVELENGTHS) -> list[tuple[int, int, str]]:
 class Bench:
     """One renderer, one size; renders (and times) points of a preset and material."""
 
-    def __init__(self, size: int) -> None:
+    def __init__(self, size: int, renderer=None) -> None:
         from opaline.gl.renderer import Renderer
 
         self.size = size
-        self.renderer = Renderer(None)
+        self.renderer = renderer or Renderer(None)
 
     def job(self, preset, material, samples: int, wavelengths: int, aa: str,
             size: int | None = None):
@@ -77,22 +77,63 @@ class Bench:
         self.renderer.release()
 
 
-def cache_path(preset, material, size: int, samples: int, wavelengths: int) -> Path:
-    from opaline import __version__
-    from opaline.resources import sources_digest
+def compiled(bench: Bench, preset, material, points) -> list:
+    """The program variants (gl/shaders.py's ProgramKey) that rendering ``points`` compiles,
+    found by rendering each at 16², the least the API takes (a variant does not depend on
+    the image's size)."""
+    programs = bench.renderer.programs
+    programs.record = seen = set()
+    try:
+        for point in points:
+            bench.renderer.render(bench.job(preset, material, *point, size=16), preset)
+    finally:
+        programs.record = None
+    return sorted(seen)
 
-    # The version too: the colour weights (D65 since 0.2.0) live in Python, not the shaders.
+
+def reference_points(rgb: bool) -> list[tuple[int, int, str]]:
+    """The references' settings (``references``): each converged one and its half."""
+    settings = [REFERENCE, (REFERENCE[0] // 2, REFERENCE[1] // 2)]
+    if rgb:
+        settings += [RGB_REFERENCE, (RGB_REFERENCE[0] // 2, RGB_REFERENCE[1])]
+    return [(s, w, "none") for s, w in settings]
+
+
+def measured_programs(bench: Bench, preset) -> list:
+    """Every program variant a preset's measurement (``measure``, each material variant)
+    compiles, references included: the table is stamped with their sources' digest."""
+    from opaline.model.auto import VARIANTS, variant_material
+    from opaline.model.request import resolve
+
+    base = resolve(_request(preset.name), preset).material
+    found: set = set()
+    for variant in VARIANTS:
+        material = variant_material(base, variant)
+        points = grid(material.mdf, WAVELENGTHS if variant == "base" else TABLE_WAVELENGTHS)
+        found.update(compiled(bench, preset, material,
+                              [*points, *reference_points(variant == "base")]))
+    return sorted(found)
+
+
+def cache_path(bench: Bench, preset, material, samples: int, wavelengths: int) -> Path:
+    from opaline import __version__
+    from opaline.gl.variant_source import variant_digest
+
+    # The programs the reference compiles, as they compile (an edit elsewhere, or to a
+    # comment, keeps it); the version too: the colour weights (D65 since 0.2.0) live in
+    # Python, not the shaders.
+    programs = compiled(bench, preset, material, [(samples, wavelengths, "none")])
     key = json.dumps({"scene": preset.scene_key(), "material": material.model_dump(mode="json"),
-                      "size": size, "shaders": sources_digest(), "version": __version__},
-                     sort_keys=True)
+                      "size": bench.size, "shaders": variant_digest(programs),
+                      "version": __version__}, sort_keys=True)
     digest = hashlib.sha256(key.encode()).hexdigest()[:12]
-    return RESULTS / f"{preset.name}-{size}-{samples}x{wavelengths}-{digest}.npy"
+    return RESULTS / f"{preset.name}-{bench.size}-{samples}x{wavelengths}-{digest}.npy"
 
 
 def reference(bench: Bench, preset, material, samples: int, wavelengths: int) -> np.ndarray:
-    """A brute-force image (aa none), from the disk cache when the shaders, scene, material
-    and size are the same."""
-    path = cache_path(preset, material, bench.size, samples, wavelengths)
+    """A brute-force image (aa none), from the disk cache when the programs it compiles,
+    scene, material and size are the same."""
+    path = cache_path(bench, preset, material, samples, wavelengths)
     if path.exists():
         return np.load(path)
     image = bench.image(preset, material, (samples, wavelengths, "none"))

@@ -1,9 +1,11 @@
 """The table quality=auto reads (service/opaline/model/quality_table.json), from the grid.
 
 Per preset: the points every material variant was measured at, with the preset's own
-time for each, and per variant its difficulty (model/auto.py) and errors. Stamped with
-the hashes of the shader sources and of each preset, so a test can tell when the table
-no longer describes what the package renders.
+time for each, and per variant its difficulty (model/auto.py) and errors. Each preset is
+stamped with its own hash and with the program variants its measurement compiled and
+the digest of their sources as they compile (gl/variant_source.py), so a test can tell
+when an entry no longer describes what the package renders, and a shader edit that
+reaches none of a preset's programs leaves its entry valid.
 """
 
 from __future__ import annotations
@@ -12,23 +14,19 @@ import json
 
 
 def quality_table(rows: list[dict], facts: list[dict], info: dict) -> bytes:
-    from opaline.resources import sources_digest
-
     table = {"command": "python bench/accuracy.py --write-table", "date": info["date"],
-             "size": info["size"], "shaders": sources_digest(), "machine": info["cpu"],
+             "size": info["size"], "machine": info["cpu"],
              "presets": preset_entries(rows, facts, info)}
     return (compact(table) + "\n").encode()
 
 
 def merged_table(old: dict, rows: list[dict], facts: list[dict], info: dict) -> bytes:
-    """``old`` (the shipped table) with the measured presets' entries in place of theirs and
-    the shaders' hash now: valid only where every other preset renders as it did when
-    measured (bench/unchanged_renders.py says whether it does). The merge is noted."""
-    from opaline.resources import sources_digest
-
+    """``old`` (the shipped table) with the measured presets' entries in place of theirs;
+    each other entry stays valid while its programs compile as they did (its digest). The
+    merge is noted."""
     entries = preset_entries(rows, facts, info)
     earlier = [m for m in old.get("merged", []) if not set(m["presets"]) <= set(entries)]
-    table = {**old, "shaders": sources_digest(),
+    table = {**old,
              "presets": {**old["presets"], **entries},
              "merged": [*earlier, {"command": info["command"], "date": info["date"],
                                    "presets": sorted(entries)}]}
@@ -37,6 +35,7 @@ def merged_table(old: dict, rows: list[dict], facts: list[dict], info: dict) -> 
 
 def preset_entries(rows: list[dict], facts: list[dict], info: dict) -> dict[str, dict]:
     """Per preset measured: its hash, the points and each material variant's errors."""
+    from opaline.gl.variant_source import variant_digest, variant_label
     from opaline.model.auto import difficulty, preset_digest
     from opaline.model.params import Material
     from opaline.model.presets import get_preset
@@ -63,13 +62,28 @@ def preset_entries(rows: list[dict], facts: list[dict], info: dict) -> dict[str,
                               "theta": [fact["material"]["theta1"], fact["material"]["theta2"]],
                               "flip": [round(found[k]["flip"], 5) for k in points],
                               "de2000_p95": [round(found[k]["de2000_p95"], 4) for k in points]})
+        listed = info.get("programs", {}).get(preset)
+        if not listed:
+            raise SystemExit(f"{preset}: its raw results list no programs (measured before "
+                             "the table stamped them): measure it again")
+        programs = sorted(tuple_key(key) for key in listed)
         presets[preset] = {
             "digest": preset_digest(get_preset(preset)),
+            "compiled": variant_digest(programs),
+            "programs": [variant_label(key) for key in programs],
             "points": [{"samples": k[0], "wavelengths": k[1], "aa": k[2],
                         "ms": round(base[k]["ms"], 2)} for k in points],
             "materials": materials,
         }
     return presets
+
+
+def tuple_key(key) -> tuple:
+    """A ProgramKey (gl/shaders.py), from the raw results' JSON lists too."""
+    name, defines = key
+    return name, tuple((d, int(v)) for d, v in defines)
+
+
 
 
 def compact(value, indent: str = "") -> str:

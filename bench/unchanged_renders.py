@@ -3,12 +3,14 @@ grid (every point and material variant bench/accuracy.py measures, 128²).
 
     python bench/unchanged_renders.py --base REV [--presets sphere cd-rom ...]
 
-A shader edit changes the hash of every source, so the quality table says it is stale
-even for presets whose programs the edit does not reach (it sits behind a define they
-do not set). ``bench/accuracy.py --merge-table`` measures only the presets named again
-and keeps the others' entries; this is what shows that keeping them is right: each
-tree (``REV`` checked out as a worktree, and this one) renders the same images in its
-own process, and their hashes are compared. Exits 1 when any image differs, and names it.
+The quality table stamps each preset with the sources its programs compile
+(gl/variant_source.py), so a shader edit marks stale only the presets it reaches. A
+change in Python (a uniform's value, the colour weights, which defines a job sets) can
+change images with no shader edited; ``bench/accuracy.py --merge-table`` measures only
+the presets named again and keeps the others' entries, and this is what shows that
+keeping them is right: each tree (``REV`` checked out as a worktree, and this one)
+renders the same images in its own process, and their hashes are compared. Exits 1 when
+any image differs, and names it.
 """
 
 from __future__ import annotations

@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import pytest
 
-from opaline import resources
 from opaline.gl import shaders
 from opaline.gl.shaders import ProgramCache, ShaderError, annotate_log, compose, expand
 from opaline.model.params import RenderRequest
@@ -27,20 +25,6 @@ def fake_sources(monkeypatch, sources: dict[str, str]) -> None:
         return sources[name]
 
     monkeypatch.setattr(shaders, "read_source", read)
-
-
-@pytest.fixture
-def glsl_copy(tmp_path, monkeypatch):
-    """A private copy of glsl/ that shaders reads from; caches cleared on both sides."""
-    root = tmp_path / "glsl"
-    shutil.copytree(shaders.glsl_root(), root)
-    monkeypatch.setattr(shaders, "glsl_root", lambda: root)
-    monkeypatch.setattr(resources, "glsl_root", lambda: root)
-    shaders.read_source.cache_clear()
-    shaders.sources_digest.cache_clear()
-    yield root
-    shaders.read_source.cache_clear()
-    shaders.sources_digest.cache_clear()
 
 
 def check_line_directives(source: str, files: list[str], read) -> int:

@@ -11,21 +11,28 @@ from pathlib import Path
 
 import pytest
 
+from opaline.gl.variant_source import variant_digest, variant_key
 from opaline.model import auto
 from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import all_presets, get_preset
 from opaline.model.request import resolve
 from opaline.model.tiers import TIERS, Tier
-from opaline.resources import sources_digest
 
 ROOT = Path(__file__).resolve().parents[2]
 REGENERATE = "python bench/accuracy.py --write-table"
 
 
-def test_table_was_measured_with_these_shaders():
-    """The table's shader hash is the package's: edit a shader and this fails until the table
-    is measured again."""
-    assert auto.load_table()["shaders"] == sources_digest(), f"stale table: run {REGENERATE}"
+@pytest.mark.parametrize("name", sorted(all_presets()))
+def test_table_was_measured_with_these_programs(name):
+    """Each preset's programs compile as they did when it was measured: edit what one of them
+    compiles and this fails until the preset is measured again. (A comment, or a branch none
+    of them takes, leaves the entry valid; tests/gl/test_quality_table.py checks that the
+    list is every program its measurement compiles.)"""
+    entry = auto.load_table()["presets"][name]
+    keys = [variant_key(label) for label in entry["programs"]]
+    assert keys, f"{name}: no programs listed"
+    assert variant_digest(keys) == entry["compiled"], (
+        f"{name}'s programs changed: run python bench/accuracy.py --presets {name} --merge-table")
 
 
 @pytest.mark.parametrize("name", sorted(all_presets()))

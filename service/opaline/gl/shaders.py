@@ -125,6 +125,9 @@ class ProgramCache:
         self.on_release = on_release
         self._programs: BudgetLRU[ProgramKey, moderngl.Program] = BudgetLRU(
             max_programs, max_programs * PROGRAM_BYTES, release=self._release)
+        # When set, every variant asked for is added to it: the accuracy benchmark stamps
+        # its measurements with them (gl/variant_source.py).
+        self.record: set[ProgramKey] | None = None
 
     def __len__(self) -> int:
         return len(self._programs)
@@ -136,6 +139,8 @@ class ProgramCache:
     def get(self, program: str, defines: Defines | None = None) -> moderngl.Program:
         defines = {k: v for k, v in (defines or {}).items() if v is not False}
         key = (program, tuple(sorted((k, int(v)) for k, v in defines.items())))
+        if self.record is not None:
+            self.record.add(key)
         found = self._programs.get(key)
         if found is None:
             found = self._compile(program, defines)

@@ -39,7 +39,9 @@ class MeasuredMaterial(TypedDict):
 
 
 class PresetEntry(TypedDict):
-    digest: str
+    digest: str  # the preset's scene and defaults (auto.preset_digest)
+    compiled: str  # the sources of its programs as they compile (gl/variant_source.py)
+    programs: list[str]  # those program variants, as variant_source.variant_label writes them
     points: list[Point]
     materials: list[MeasuredMaterial]
 
@@ -48,7 +50,6 @@ class Table(TypedDict):
     command: str
     date: str
     size: int
-    shaders: str
     machine: str
     presets: dict[str, PresetEntry]
 

@@ -1,0 +1,53 @@
+"""The accuracy table's program lists (service/opaline/model/quality_table.json): each
+preset's is every program variant its measurement compiles now, so that its digest
+(tests/model/test_auto.py) covers all a shader edit could change in its figures."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+from opaline.gl.variant_source import variant_label
+from opaline.model import auto
+from opaline.model.presets import get_preset
+
+BENCH = Path(__file__).resolve().parents[2] / "bench"
+
+
+def _accuracy_grid():
+    sys.path.insert(0, str(BENCH))  # its own imports (metrics.py) sit beside it
+    try:
+        spec = importlib.util.spec_from_file_location("opaline_bench_grid",
+                                                      BENCH / "accuracy_grid.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(BENCH))
+    return module
+
+
+pytest.importorskip("flip_evaluator")  # bench/metrics.py's
+accuracy_grid = _accuracy_grid()
+
+
+# One preset of each kind of program the table's entries compile: a film under the studio
+# with transmission (55 variants: the map's samples a pass follow the samples), a grating
+# read by its orders, and the paper's rotation model under its own light. All nineteen took
+# 4 min (each variant compiled once), too long for what one shared code path decides;
+# bench/accuracy.py lists every preset's when it measures it.
+KINDS = ("soap-bubble", "cd-rom-grating", "cd-rom")
+
+
+@pytest.mark.parametrize("name", KINDS)
+def test_table_lists_every_program_the_measurement_compiles(renderer, name):
+    """Rendering the preset's grid, every material variant and the references (each
+    once, 16²) asks for exactly the variants the table lists: a change to the code that picks
+    defines, with no shader edit, still shows."""
+    bench = accuracy_grid.Bench(auto.TABLE_SIZE, renderer)
+    found = [variant_label(key) for key in accuracy_grid.measured_programs(
+        bench, get_preset(name))]
+    assert found == auto.load_table()["presets"][name]["programs"], (
+        f"run python bench/accuracy.py --presets {name} --merge-table")
