@@ -44,10 +44,11 @@ ROOT = Path(__file__).resolve().parents[1]
 # Runnable as a script from a checkout: the bench's modules and the service package.
 sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "service")]
 from accuracy_grid import Bench, measure, measured_programs, paired_ratios  # noqa: E402
+from accuracy_merge import RAW, last_run, merged  # noqa: E402
+from opaline.gl.variant_source import variant_digest  # noqa: E402
 from opaline.output.files import write_atomic  # noqa: E402
 
 DOCS = ROOT / "docs"
-RAW = ROOT / "bench" / "results" / "accuracy_grid.json"
 
 
 def machine(bench: Bench) -> dict[str, str]:
@@ -79,7 +80,7 @@ def run(names: list[str], size: int, variants: list[str], tiers: bool = True) ->
     started = time.perf_counter()
     bench = Bench(size)
     info = {**machine(bench), "size": size, "load": [os.getloadavg()[0]], **invocation(),
-            "programs": {}}
+            "programs": {}, "compiled": {}}
     rows, facts = [], []
     try:
         for name in names:
@@ -91,7 +92,11 @@ def run(names: list[str], size: int, variants: list[str], tiers: bool = True) ->
                 more, found = measure(bench, presets[name], variant, base["times"])
                 rows += more
                 facts.append(found["facts"])
-            info["programs"][name] = measured_programs(bench, presets[name])
+            programs = measured_programs(bench, presets[name], variants)
+            info["programs"][name] = programs
+            # Hashed now, from the sources just measured: written later (--merge,
+            # --from-results), an entry would carry the digest of sources edited since.
+            info["compiled"][name] = variant_digest(programs)
             print(f"{name}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
         ratios = time_tiers(bench, names) if tiers else {}
     finally:
@@ -197,38 +202,6 @@ def merge_table(parser: argparse.ArgumentParser, args: argparse.Namespace) -> No
     write_atomic(TABLE_PATH, merged_table(shipped, data["rows"], data["facts"], data["info"]))
     print(f"{', '.join(args.presets)}: measured in {data['info']['wall_s']:.0f} s; "
           f"their entries in {TABLE_PATH.relative_to(ROOT)} replaced")
-
-
-def last_run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> dict:
-    """The results --merge keeps, refused before the hour of measuring, not after: none
-    named, none there, or another size."""
-    if not args.presets:
-        parser.error("--merge needs --presets: the presets to measure again")
-    if not RAW.is_file():
-        parser.error(f"--merge: no last run to merge into ({RAW.relative_to(ROOT)})")
-    last: dict = json.loads(RAW.read_text())
-    if last["info"]["size"] != args.size:
-        parser.error(f"--merge: the last run was at {last['info']['size']}², "
-                     f"this one would be at {args.size}²")
-    return last
-
-
-def merged(old: dict, new: dict, names: list[str]) -> dict:
-    """The last run's results with ``names``' rows, facts and tier ratios from ``new``; the
-    info is the last run's, with this run noted (what it measured, when, how long) in
-    place of earlier merges whose presets it measured again."""
-    keep = set(names)
-    earlier = [m for m in old["info"].get("merged", [])
-               if not ("presets" in m and set(m["presets"]) <= keep)]
-    info = {**old["info"], "programs": {**old["info"].get("programs", {}),
-                                        **new["info"]["programs"]},
-            "merged": [*earlier, {
-        **{key: new["info"][key] for key in ("command", "date", "wall_s", "load")},
-        "presets": sorted(keep)}]}
-    return {"info": info,
-            "rows": [r for r in old["rows"] if r["preset"] not in keep] + new["rows"],
-            "facts": [f for f in old["facts"] if f["preset"] not in keep] + new["facts"],
-            "tier_ratios": {**old.get("tier_ratios", {}), **new["tier_ratios"]}}
 
 
 def write_outputs(data: dict, out: Path, table: bool) -> None:

@@ -99,15 +99,15 @@ def reference_points(rgb: bool) -> list[tuple[int, int, str]]:
     return [(s, w, "none") for s, w in settings]
 
 
-def measured_programs(bench: Bench, preset) -> list:
-    """Every program variant a preset's measurement (``measure``, each material variant)
-    compiles, references included: the table is stamped with their sources' digest."""
-    from opaline.model.auto import VARIANTS, variant_material
+def measured_programs(bench: Bench, preset, variants: list[str]) -> list:
+    """Every program variant a preset's measurement (``measure``, its own material and
+    ``variants``) compiles, references included: the table is stamped with their digest."""
+    from opaline.model.auto import variant_material
     from opaline.model.request import resolve
 
     base = resolve(_request(preset.name), preset).material
     found: set = set()
-    for variant in VARIANTS:
+    for variant in ["base", *variants]:
         material = variant_material(base, variant)
         points = grid(material.mdf, WAVELENGTHS if variant == "base" else TABLE_WAVELENGTHS)
         found.update(compiled(bench, preset, material,

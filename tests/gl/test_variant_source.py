@@ -36,6 +36,12 @@ def digests() -> tuple[str, str]:
     return variant_digest([ROTATION]), variant_digest([GRATING])
 
 
+def edit(path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text, f"{path.name} no longer has {old!r}: the test needs another edit"
+    path.write_text(text.replace(old, new, 1))
+
+
 @pytest.mark.parametrize(("expression", "macros", "expected"), [
     ("defined(A) && !defined(B)", {"A": 1}, True),
     ("!defined(A) && !defined(B) && !defined(C)", {"C": 1}, False),
@@ -61,37 +67,59 @@ def test_nested_branches_and_include_guards():
     assert active_lines(source) == ["#define GUARD", "#define N 2", "a;", "b;", "d;", "h;"]
 
 
-def test_an_unsupported_condition_or_an_unclosed_branch_is_an_error():
+@pytest.mark.parametrize(("expression", "macros"), [
+    ("foo(1)", {}), ("A &&", {"A": 1}),
+    # where C and a textual translation to Python disagree: refused, not guessed
+    ("!A == B", {"A": 2, "B": 1}), ("!A + 1", {"A": 0}), ("3 > 2 > 1", {}),
+    ("1 & 2 == 2", {}), ("-7 / 2 == -3", {}), ("-7 % 2 == -1", {}),
+    ("BINS > 8", {"BINS": None}),  # #define BINS WAVELENGTHS: not an integer
+])
+def test_an_expression_outside_the_subset_is_an_error(expression, macros):
     with pytest.raises(ShaderError, match="subset"):
-        evaluate("foo(1)", {})
-    with pytest.raises(ShaderError, match="subset"):
-        evaluate("A &&", {"A": 1})
+        evaluate(expression, macros)
+
+
+def test_directives_outside_the_subset_or_unclosed_branches_are_errors():
     with pytest.raises(ShaderError, match="unterminated"):
         active_lines("#ifdef A\na;\n")
+    with pytest.raises(ShaderError, match="block comments"):
+        active_lines("a; /* b */\n")
+    with pytest.raises(ShaderError, match="subset"):
+        active_lines("#define F(x) x\n#if F > 0\n#endif\n")
+
+
+def test_undef_and_an_enabled_extension_are_read():
+    """The driver defines an extension's macro where it has it (llvmpipe has every one
+    compose enables): its branch is the one compiled."""
+    source = "\n".join(["#extension GL_ARB_derivative_control : enable", "#define A",
+                        "#undef A", "#ifdef GL_ARB_derivative_control", "fine;", "#else",
+                        "coarse;", "#endif", "#ifdef A", "a;", "#endif"])
+    assert active_lines(source)[1:] == ["#define A", "#undef A", "fine;"]
 
 
 def test_a_comment_or_a_skipped_branch_leaves_a_variants_digest(glsl_copy):
     """sources_digest changes with any edit; a variant's digest only with its own code."""
     rotation, grating = digests()
     light = glsl_copy / "lib" / "environment_light.glsl"
-    original = light.read_text()
-    light.write_text(original.replace("// Into the map's own frame", "// Into the map frame"))
+    edit(light, "// Into the map's own frame", "// Into the map frame\n// and a new line")
     assert digests() == (rotation, grating)
     # Each variant skips the other's code: the grating's orders and the three lobes.
-    orders = glsl_copy / "lib" / "environment_grating.glsl"
-    orders.write_text(orders.read_text().replace("float k = l.z + nv;", "float k = nv + l.z;"))
+    edit(glsl_copy / "lib" / "environment_grating.glsl", "float k = l.z + nv;",
+         "float k = nv + l.z;")
     rotation_now, grating_now = digests()
     assert rotation_now == rotation and grating_now != grating
-    light.write_text(original.replace(
-        "    int c = int(min(u.z * 3.0, 2.0));", "    int c = int(min(u.z * 3.0, 1.0));"))
+    edit(light, "    int c = int(min(u.z * 3.0, 2.0));", "    int c = int(min(u.z * 3.0, 1.0));")
     changed = digests()
     assert changed[0] != rotation and changed[1] == grating_now
+    # The quad's mean takes the fine derivatives where the extension is there (llvmpipe).
+    edit(light, "#define QUAD_DX dFdxFine", "#define QUAD_DX dFdxCoarse")
+    assert digests()[0] != changed[0]
 
 
 def test_an_edit_to_code_every_variant_compiles_changes_each_digest(glsl_copy):
     rotation, grating = digests()
-    light = glsl_copy / "lib" / "environment_light.glsl"
-    light.write_text(light.read_text().replace("* env.intensity;", "* env.intensity * 1.0;", 1))
+    edit(glsl_copy / "lib" / "environment_light.glsl", "* env.intensity;",
+         "* env.intensity * 1.0;")
     changed = digests()
     assert changed[0] != rotation and changed[1] != grating
 
