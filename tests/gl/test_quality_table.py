@@ -4,33 +4,14 @@ preset's is every program variant its measurement compiles now, so that its dige
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import pytest
 
+from bench_metrics import load_bench
 from opaline.gl.variant_source import variant_label
 from opaline.model import auto
 from opaline.model.presets import get_preset
 
-BENCH = Path(__file__).resolve().parents[2] / "bench"
-
-
-def _accuracy_grid():
-    sys.path.insert(0, str(BENCH))  # its own imports (metrics.py) sit beside it
-    try:
-        spec = importlib.util.spec_from_file_location("opaline_bench_grid",
-                                                      BENCH / "accuracy_grid.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(BENCH))
-    return module
-
-
-pytest.importorskip("flip_evaluator")  # bench/metrics.py's
-accuracy_grid = _accuracy_grid()
+accuracy_grid = load_bench("accuracy_grid")
 
 
 # One preset of each kind of program the table's entries compile: a film under the studio

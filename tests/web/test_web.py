@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import base64
-import importlib.util
 import shlex
 import subprocess
 import time
@@ -12,9 +11,9 @@ from urllib.parse import parse_qs, urlsplit
 
 import pytest
 
+from bench_metrics import load_bench
 from opaline.server.localserver import LocalServer, ServerError, loopback_env
 
-ROOT = Path(__file__).resolve().parents[2]
 CHROMIUM = Path("/usr/bin/chromium")
 # Only 127.0.0.1 traffic: no background networking, updates, sync or QUIC probes.
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -27,10 +26,7 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
 WAIT_MS = 30_000
 START_S = 60.0    # the service's start-up: worker thread, GL context, warm-up, calibration
 
-_spec = importlib.util.spec_from_file_location("opaline_bench_web_drag",
-                                               ROOT / "bench" / "web_drag.py")
-web_drag = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(web_drag)
+web_drag = load_bench("web_drag")
 
 pytestmark = pytest.mark.skipif(not CHROMIUM.exists(),
                                 reason=f"{CHROMIUM} is missing (Debian's chromium package)")
