@@ -44,6 +44,10 @@ CASES = [
     ("oil-film", {"quality": "standard", "substrate": "conductor", "wavelengths": 16}),
     ("sphere", {"iridescence": "thin-film", "wavelengths": 0}),
     ("tempered-steel", {"quality": "draft", "wavelengths": 0, "substrate": "dielectric"}),
+    # A stack takes the tier's stack_wavelengths (32 at standard, where a film takes 0).
+    ("bragg-mirror", {"quality": "standard", "wavelengths": 32}),
+    ("bragg-mirror", {"quality": "standard", "wavelengths": 0}),
+    ("oil-film", {"quality": "standard", "film_stack_pairs": 3, "wavelengths": 32}),
 ]
 
 

@@ -11,7 +11,7 @@
 // where the pick is the preset's tier.
 // tests/web/test_web_canonical.py checks the spelling against the service's.
 import { same } from './dom.js';
-import { state, tierSetting } from './state.js';
+import { state, TIER_MATERIAL, tierSetting } from './state.js';
 
 // pipeline/canonical.py REQUEST_ONLY: the fields a job does not keep, right after the preset.
 export const REQUEST_ONLY = ['mesh', 'tangent_field', 'tangent_axis', 'max_flip', 'max_delta_e'];
@@ -56,7 +56,7 @@ function baseOf(name, info, tier, fields) {
   if (TIER_SETTINGS.includes(name)) {
     if (name in info.defaults) return info.defaults[name];
     const material = { ...info.resolved.material };
-    for (const key of ['iridescence', 'substrate']) if (key in fields) material[key] = fields[key];
+    for (const key of TIER_MATERIAL) if (key in fields) material[key] = fields[key];
     return tierSetting(name, tier, material);
   }
   return info.resolved[name] ?? null;

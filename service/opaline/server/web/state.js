@@ -45,16 +45,20 @@ export const valueOf = (name) => (name in state.overrides ? state.overrides[name
 
 // What the chosen quality tier sets for a tier field, when the tier is a named one.
 // model/tiers.py Tier.wavelengths_for: a tier's wavelengths for the colour source drawn
-// (a film's are its own, on a dielectric or on a metal).
+// (a film's are its own: a stack's, else on a dielectric or on a metal).
 export function tierSetting(name, tier, material) {
   if (tier === undefined || name !== 'wavelengths' || material.iridescence !== 'thin-film') {
     return tier?.[name];
   }
+  if (material.film_stack_pairs > 0) return tier.stack_wavelengths;
   return material.substrate === 'conductor' ? tier.metal_film_wavelengths : tier.film_wavelengths;
 }
 
+// The material fields tierSetting reads.
+export const TIER_MATERIAL = ['iridescence', 'substrate', 'film_stack_pairs'];
+
 export const tierValue = (name) => tierSetting(name, state.tiers.get(valueOf('quality')),
-  { iridescence: valueOf('iridescence'), substrate: valueOf('substrate') });
+  Object.fromEntries(TIER_MATERIAL.map((key) => [key, valueOf(key)])));
 
 // The fields sent: the user's changes, in schema order.
 export function changedFields() {
