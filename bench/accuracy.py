@@ -45,7 +45,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "service")]
 from accuracy_grid import Bench, measure, measured_programs, paired_ratios  # noqa: E402
 from accuracy_merge import RAW, last_run, merged  # noqa: E402
-from opaline.gl.variant_source import variant_digest  # noqa: E402
+from opaline.gl.variant_source import variant_digest, variant_label  # noqa: E402
 from opaline.output.files import write_atomic  # noqa: E402
 
 DOCS = ROOT / "docs"
@@ -93,7 +93,8 @@ def run(names: list[str], size: int, variants: list[str], tiers: bool = True) ->
                 rows += more
                 facts.append(found["facts"])
             programs = measured_programs(bench, presets[name], variants)
-            info["programs"][name] = programs
+            # As the table lists them (one spelling, the raw results' and the table's).
+            info["programs"][name] = [variant_label(key) for key in programs]
             # Hashed now, from the sources just measured: written later (--merge,
             # --from-results), an entry would carry the digest of sources edited since.
             info["compiled"][name] = variant_digest(programs)

@@ -19,9 +19,10 @@ def last_run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> dict:
     if not RAW.is_file():
         parser.error(f"--merge: no last run to merge into ({RAW.relative_to(ROOT)})")
     last: dict = json.loads(RAW.read_text())
-    if "compiled" not in last["info"]:
-        parser.error("--merge: the last run's presets carry no program stamps (measured "
-                     "before the table had them): measure every preset again")
+    labels = [p for programs in last["info"].get("programs", {}).values() for p in programs]
+    if "compiled" not in last["info"] or not all(isinstance(p, str) for p in labels):
+        parser.error("--merge: the last run's presets carry no program stamps as the table "
+                     "lists them (measured before it did): measure every preset again")
     if last["info"]["size"] != args.size:
         parser.error(f"--merge: the last run was at {last['info']['size']}², "
                      f"this one would be at {args.size}²")

@@ -35,7 +35,7 @@ def merged_table(old: dict, rows: list[dict], facts: list[dict], info: dict) -> 
 
 def preset_entries(rows: list[dict], facts: list[dict], info: dict) -> dict[str, dict]:
     """Per preset measured: its hash, the points and each material variant's errors."""
-    from opaline.gl.variant_source import variant_label
+    from opaline.gl.variant_source import variant_key
     from opaline.model.auto import difficulty, preset_digest
     from opaline.model.params import Material
     from opaline.model.presets import get_preset
@@ -66,22 +66,15 @@ def preset_entries(rows: list[dict], facts: list[dict], info: dict) -> dict[str,
         if not listed or preset not in info.get("compiled", {}):
             raise SystemExit(f"{preset}: its raw results carry no program stamp (measured "
                              "before the table had them): measure it again")
-        programs = sorted(tuple_key(key) for key in listed)
         presets[preset] = {
             "digest": preset_digest(get_preset(preset)),
             "compiled": info["compiled"][preset],  # as measured (bench/accuracy.py run)
-            "programs": [variant_label(key) for key in programs],
+            "programs": sorted(listed, key=variant_key),
             "points": [{"samples": k[0], "wavelengths": k[1], "aa": k[2],
                         "ms": round(base[k]["ms"], 2)} for k in points],
             "materials": materials,
         }
     return presets
-
-
-def tuple_key(key) -> tuple:
-    """A ProgramKey (gl/shaders.py), from the raw results' JSON lists too."""
-    name, defines = key
-    return name, tuple((d, int(v)) for d, v in defines)
 
 
 def compact(value, indent: str = "") -> str:
