@@ -132,3 +132,25 @@ def test_a_cd_under_the_studio_shows_its_orders(renderer):
 
     grooved, flat = disc_chroma(), disc_chroma(grating_depth=0.0)
     assert grooved > 3.0 * flat, (grooved, flat)
+
+
+def test_the_orders_read_from_the_map_sum_a_shorter_series(renderer):
+    """Where a grating's orders are read from the map, J_m's series is cut at
+    READS_SERIES_TOLERANCE (7 terms at the CD's 150 nm); under its key light, where the
+    shading is checked against its twin to 1e-6, at SERIES_TOLERANCE (9)."""
+    from opaline.model.grating import READS_SERIES_TOLERANCE, bessel_terms
+
+    preset = get_preset("cd-rom-grating")
+    seen: set = set()
+    renderer.programs.record = seen
+    try:
+        for environment in ("studio", None):
+            job = resolve(RenderRequest(preset="cd-rom-grating", width=16, height=16,
+                                        environment=environment), preset)
+            renderer.render(job, preset=preset)
+    finally:
+        renderer.programs.record = None
+    terms = {bool(dict(defines).get("ENV_GRATING_ORDERS")): dict(defines)["BESSEL_TERMS"]
+             for name, defines in seen if name == "surface.glsl"}
+    assert terms == {True: bessel_terms(150.0, READS_SERIES_TOLERANCE),
+                     False: bessel_terms(150.0)} == {True: 7, False: 9}

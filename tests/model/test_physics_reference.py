@@ -156,6 +156,31 @@ def test_bessel_series_matches_scipy(m):
     assert np.allclose(grating.bessel_j(m, x), jv(m, x), rtol=0, atol=1e-12)
 
 
+def shader_series(m: int, x: np.ndarray, terms: int) -> np.ndarray:
+    """glsl/lib/grating.glsl bessel_j with BESSEL_TERMS = terms, in float64."""
+    lead = (0.5 * x) ** m / math.factorial(m)
+    y = -0.25 * x * x
+    series = np.ones_like(x)
+    for k in range(terms - 1, 0, -1):
+        series = 1.0 + y * series / (k * (k + m))
+    result: np.ndarray = lead * series
+    return result
+
+
+@pytest.mark.parametrize("tolerance", [grating.SERIES_TOLERANCE, grating.READS_SERIES_TOLERANCE])
+@pytest.mark.parametrize("depth", [50.0, 120.0, 150.0, 250.0, 400.0])
+def test_the_shaders_bessel_series_is_cut_within_its_tolerance(depth, tolerance):
+    """bessel_terms(depth, tolerance) terms of J_m's series, over every argument the depth
+    reaches (a ≤ π·depth·2/380 nm) and the orders the shader writes out: within the
+    tolerance of J_m (the reads' 1e-6 cuts two terms at the CD's 150 nm), and one term
+    fewer is not."""
+    x = np.linspace(0.0, math.pi * depth * 2.0 / 380.0, 400)
+    terms = grating.bessel_terms(depth, tolerance)
+    worst = max(float(np.abs(shader_series(m, x, terms) - jv(m, x)).max()) for m in range(9))
+    short = max(float(np.abs(shader_series(m, x, terms - 1) - jv(m, x)).max()) for m in range(9))
+    assert worst <= tolerance < short
+
+
 def test_efficiencies_of_all_orders_sum_to_one():
     lam = np.linspace(380.0, 780.0, 9)
     for depth in (0.0, 100.0, 400.0):

@@ -153,7 +153,8 @@ class Probes:
                                     and wavelengths > 0 and not brute),
                    "ENV_RGB_LOBES": rgb_lobes,
                    "ENV_GRATING_ORDERS": grating_reads > 0,
-                   "ENV_GRATING_READS": grating_reads or False}
+                   "ENV_GRATING_READS": grating_reads or False,
+                   **(environment_light.reads_bessel_terms(material) if grating_reads else {})}
         program = res.programs.get("lobe_probe.glsl", defines)
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,

@@ -43,6 +43,13 @@ if TYPE_CHECKING:
 
 BESSEL_TERMS = 24  # series terms: below 1e-9 of the sum for a ≤ 7 (depth ≤ 400 nm)
 SHADER_BESSEL_TERMS = 16  # the shader's most: truncation below 1e-9 for a ≤ 7
+# J_m's series is cut where its first term left out is under this: 1e-9 where the shading
+# is checked against its float64 twin to 1e-6. A map read of the orders
+# (glsl/lib/environment_grating.glsl) is a box over the map, within FLIP 0.03-0.07 of the
+# reads converged (bench/grating_environment.py): there 1e-6, two terms fewer at the CD's
+# 150 nm, whose Bessel series were ~60 % of what the studio adds to its key light's time.
+SERIES_TOLERANCE = 1e-9
+READS_SERIES_TOLERANCE = 1e-6
 EPS_K2 = 1e-12
 
 
@@ -59,14 +66,15 @@ def bessel_j(m: int, x: npt.ArrayLike) -> FloatArray:
     return total
 
 
-def bessel_terms(depth_nm: float) -> int:
+def bessel_terms(depth_nm: float, tolerance: float = SERIES_TOLERANCE) -> int:
     """The terms the shader sums J_m's series to (its BESSEL_TERMS define): the fewest
-    whose first left out, (a/2)^2k/k!², is under 1e-9 at the largest a this depth reaches,
-    π·depth·2/380 nm (n·(l+v) ≤ 2, λ ≥ 380 nm); 16 at the deepest grooves (a ≤ 6.6).
-    A shallow groove's series is short: 9 terms at the CD's 150 nm, about half the cost."""
+    whose first left out, (a/2)^2k/k!², is under ``tolerance`` at the largest a this depth
+    reaches, π·depth·2/380 nm (n·(l+v) ≤ 2, λ ≥ 380 nm); 16 at the deepest grooves
+    (a ≤ 6.6). A shallow groove's series is short: 9 terms at the CD's 150 nm, about half
+    the cost."""
     half_x = math.pi * depth_nm * 2.0 / 380.0 / 2.0
     term, k = 1.0, 0
-    while term >= 1e-9 and k < SHADER_BESSEL_TERMS:
+    while term >= tolerance and k < SHADER_BESSEL_TERMS:
         k += 1
         term *= half_x * half_x / (k * k)
     return max(k, 2)
