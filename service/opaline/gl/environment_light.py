@@ -68,12 +68,13 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
     # samples (spectral ones).
     three_lobes = material.iridescence == "rotation" and material.mdf == "ashikhmin" and shared
     film_per_pixel = material.iridescence == "thin-film" and film_shared
+    orders = reads_orders(job) and not brute
     return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples, brute),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
-            "ENV_GRATING_ORDERS": reads_orders(job) and not brute,
-            **(reads_bessel_terms(material) if reads_orders(job) and not brute else {}),
+            "ENV_GRATING_ORDERS": orders,
+            **(reads_bessel_terms(material) if orders else {}),
             "ENV_GRATING_READS": grating_reads(job, samples, brute) or False,
             "FILM_PER_PIXEL": film_per_pixel,
             "ENV_RGB_LOBES": three_lobes and job.wavelengths > 0,
