@@ -154,3 +154,18 @@ def test_the_orders_read_from_the_map_sum_a_shorter_series(renderer):
              for name, defines in seen if name == "surface.glsl"}
     assert terms == {True: bessel_terms(150.0, READS_SERIES_TOLERANCE),
                      False: bessel_terms(150.0)} == {True: 7, False: 9}
+
+
+def test_the_series_length_is_the_materials_define_alone():
+    """The surface program's BESSEL_TERMS comes from the material's defines, which know
+    whether the orders are read from the map: no later define set has to override it
+    (the brute-force reference samples the whole lobe and sums the key light's series)."""
+    from opaline.gl.material_program import surface_defines
+
+    preset = get_preset("cd-rom-grating")
+
+    def terms(environment: str | None, brute: bool = False) -> int | bool:
+        job = resolve(RenderRequest(preset="cd-rom-grating", environment=environment), preset)
+        return surface_defines(job, preset, brute)["BESSEL_TERMS"]
+
+    assert (terms("studio"), terms("studio", brute=True), terms(None)) == (7, 9, 9)

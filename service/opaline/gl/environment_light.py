@@ -74,7 +74,6 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
             "ENV_GRATING_ORDERS": orders,
-            **(reads_bessel_terms(material) if orders else {}),
             "ENV_GRATING_READS": grating_reads(job, samples, brute) or False,
             "FILM_PER_PIXEL": film_per_pixel,
             "ENV_RGB_LOBES": three_lobes and job.wavelengths > 0,
@@ -89,13 +88,6 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             # derivative of the multi-peak phase at it means nothing: the brute-force
             # reference reads the bands unfiltered (the split lobe filters its own).
             **({"AA_ANALYTIC": False} if brute and material.mdf == "multipeak" else {})}
-
-
-def reads_bessel_terms(material: Material) -> dict[str, int]:
-    """The Bessel series' length where a grating's orders are read from the map (its lights
-    in the same program too): model/grating.py READS_SERIES_TOLERANCE."""
-    return {"BESSEL_TERMS": grating.bessel_terms(material.grating_depth,
-                                                 grating.READS_SERIES_TOLERANCE)}
 
 
 def map_uniforms(texture: moderngl.Texture, irradiance: np.ndarray) -> Uniforms:

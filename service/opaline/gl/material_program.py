@@ -29,6 +29,7 @@ import numpy as np
 from opaline.gl import heightfield
 from opaline.gl.uniforms import Uniforms
 from opaline.model import coat, grating, metals, stack_film, visible
+from opaline.model.environment_light import reads_orders
 from opaline.model.params import Material
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -52,9 +53,14 @@ def plot_defines(material: Material, wavelengths: int = 0, aa: str = "none") -> 
     }
 
 
-def _physical_defines(material: Material) -> Defines:
+def _physical_defines(material: Material, orders_read: bool) -> Defines:
     """What a physical source decides, the contested defines included (the table above)."""
     thin_film = material.iridescence == "thin-film"
+    # A grating's orders read from an environment map are a box filter within FLIP
+    # 0.03-0.07 of the converged reads: their series is cut at READS_SERIES_TOLERANCE (its
+    # lights in the same program too); everywhere else at the key light's, which is
+    # checked against its float64 twin to 1e-6.
+    tolerance = grating.READS_SERIES_TOLERANCE if orders_read else grating.SERIES_TOLERANCE
     return {
         "IRIDESCENCE_THIN_FILM": thin_film,
         "IRIDESCENCE_GRATING": not thin_film,
@@ -65,19 +71,23 @@ def _physical_defines(material: Material) -> Defines:
         # Defines so the order and Bessel loops unroll (glsl/lib/grating.glsl), the series
         # no longer than the grooves' depth needs.
         "GRATING_ORDERS": False if thin_film else material.grating_orders,
-        "BESSEL_TERMS": False if thin_film else grating.bessel_terms(material.grating_depth),
+        "BESSEL_TERMS": False if thin_film else grating.bessel_terms(material.grating_depth,
+                                                                      tolerance),
     }
 
 
-def material_defines(material: Material, wavelengths: int = 0, aa: str = "none") -> Defines:
-    """Only the features this material uses (docs/design.md §4.3)."""
+def material_defines(material: Material, wavelengths: int = 0, aa: str = "none",
+                     orders_read: bool = False) -> Defines:
+    """Only the features this material uses (docs/design.md §4.3); ``orders_read``: a
+    grating's orders are read from an environment map (gl/environment_light.py)."""
     defines = {
         **plot_defines(material, wavelengths, aa),
         "DIFFUSE": material.kd > 0.0 and max(material.albedo) > 0.0,
         "FRESNEL": material.f0 < 1.0,
     }
     if is_physical(material):
-        defines.update(_physical_defines(material))  # applied last: the physical source wins
+        # Applied last: the physical source wins.
+        defines.update(_physical_defines(material, orders_read))
     if is_conductor(material):
         defines["SUBSTRATE_CONDUCTOR"] = True
     if has_film_weight(material):
@@ -114,9 +124,11 @@ def uses_transmission(material: Material, preset: Preset) -> bool:
     return material.iridescence == "thin-film" and preset.transmission and not is_conductor(material)
 
 
-def surface_defines(job: Job, preset: Preset) -> Defines:
-    """The surface program's defines: the material's, then the scene's (no key in common)."""
-    defines = material_defines(job.material, job.wavelengths, job.aa)
+def surface_defines(job: Job, preset: Preset, brute: bool = False) -> Defines:
+    """The surface program's defines: the material's, then the scene's (no key in common);
+    ``brute``: the brute-force reference, which samples a grating's whole lobe."""
+    orders_read = reads_orders(job) and not brute
+    defines = material_defines(job.material, job.wavelengths, job.aa, orders_read)
     defines["NORMAL_MAP"] = preset.normal_map is not None
     defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
     defines["LIGHT_COUNT"] = len(preset.lights)

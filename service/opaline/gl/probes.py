@@ -146,15 +146,15 @@ class Probes:
         coloured_by_rotation = material.iridescence == "rotation"
         if rgb_lobes and not (coloured_by_rotation and material.mdf == "ashikhmin"):
             raise ValueError("rgb_lobes: only the rotation source's Ashikhmin-Shirley lobes")
-        defines = {**material_program.material_defines(material, wavelengths),
+        defines = {**material_program.material_defines(material, wavelengths,
+                                                       orders_read=grating_reads > 0),
                    "ENV_SAMPLES": samples, "ENV_BRUTE": brute,
                    # As the renderer decides (gl/environment_light.py), for one case.
                    "ENV_ENVELOPE": (coloured_by_rotation and material.mdf == "multipeak"
                                     and wavelengths > 0 and not brute),
                    "ENV_RGB_LOBES": rgb_lobes,
                    "ENV_GRATING_ORDERS": grating_reads > 0,
-                   "ENV_GRATING_READS": grating_reads or False,
-                   **(environment_light.reads_bessel_terms(material) if grating_reads else {})}
+                   "ENV_GRATING_READS": grating_reads or False}
         program = res.programs.get("lobe_probe.glsl", defines)
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,

@@ -107,7 +107,7 @@ class SurfacePass:
     def _program(self, job: Job, preset: Preset, scene: SceneGPU, plan: DrawPlan,
                  where: Placement) -> moderngl.Program:
         """The surface variant for this job and plan, its uniforms set and textures bound."""
-        defines = material_program.surface_defines(job, preset)
+        defines = material_program.surface_defines(job, preset, plan.brute)
         if scene.projection is not None:
             defines["OBJECT_PROJECTION"] = True
         if plan.display:
