@@ -43,6 +43,9 @@ class Bench:
 
         self.size = size
         self.renderer = renderer or Renderer(None)
+        # (preset, material, point) → the programs rendering it compiles (``compiled``):
+        # a reference's cache key and the table's stamps ask for the same points.
+        self.programs_at: dict[tuple[str, str, tuple], frozenset] = {}
 
     def job(self, preset, material, samples: int, wavelengths: int, aa: str,
             size: int | None = None):
@@ -80,15 +83,24 @@ class Bench:
 def compiled(bench: Bench, preset, material, points) -> list:
     """The program variants (gl/shaders.py's ProgramKey) that rendering ``points`` compiles,
     found by rendering each at 16², the least the API takes (a variant does not depend on
-    the image's size)."""
+    the image's size), once a bench: a point's programs are kept (``Bench.programs_at``)."""
+    found: set = set()
+    for point in points:
+        key = (preset.name, material.model_dump_json(), tuple(point))
+        if key not in bench.programs_at:
+            bench.programs_at[key] = frozenset(_render_recorded(bench, preset, material, point))
+        found.update(bench.programs_at[key])
+    return sorted(found)
+
+
+def _render_recorded(bench: Bench, preset, material, point) -> set:
     programs = bench.renderer.programs
     programs.record = seen = set()
     try:
-        for point in points:
-            bench.renderer.render(bench.job(preset, material, *point, size=16), preset)
+        bench.renderer.render(bench.job(preset, material, *point, size=16), preset)
     finally:
         programs.record = None
-    return sorted(seen)
+    return seen
 
 
 def reference_points(rgb: bool) -> list[tuple[int, int, str]]:

@@ -32,3 +32,21 @@ def test_table_lists_every_program_the_measurement_compiles(renderer, name):
         bench, get_preset(name), list(auto.VARIANTS[1:]))]
     assert found == auto.load_table()["presets"][name]["programs"], (
         f"run python bench/accuracy.py --presets {name} --merge-table")
+
+
+def test_a_points_programs_are_found_once_a_bench(renderer, monkeypatch):
+    """A reference's cache key and the table's stamps ask for the same points' programs:
+    each point is rendered (16²) to find them once a bench, not once a question."""
+    from opaline.model.request import preset_material
+
+    bench = accuracy_grid.Bench(auto.TABLE_SIZE, renderer)
+    preset = get_preset("cd-rom")
+    material = preset_material(preset)
+    rendered = []
+    render = renderer.render
+    monkeypatch.setattr(renderer, "render",
+                        lambda job, *args, **kwargs: rendered.append(job) or render(job, *args, **kwargs))
+    first = accuracy_grid.compiled(bench, preset, material, [(4, 8, "none")])
+    both = accuracy_grid.compiled(bench, preset, material, [(4, 8, "none"), (2, 8, "none")])
+    assert len(rendered) == 2
+    assert first and set(first) <= set(both)
