@@ -35,11 +35,18 @@ from opaline.model.stack_film import is_stack
 FILM_PER_SAMPLE_FROM = 48
 
 
+def orders_read(job: Job, brute: bool = False) -> bool:
+    """Whether this draw reads a grating's orders from the map: the job's choice
+    (model.environment_light.reads_orders), never in the brute-force reference, which
+    samples the whole lobe."""
+    return reads_orders(job) and not brute
+
+
 def samples_per_pass(job: Job, samples: SamplePlan, brute: bool = False) -> int:
     """A pass's lobe samples; the multi-peak lobe's band samples where it is split, none
     where a grating's orders are read (never in the brute-force reference, which samples
     the whole lobe)."""
-    if reads_orders(job) and not brute:
+    if orders_read(job, brute):
         return 0
     per_pass = _per_pass(job, samples)
     return band_samples(job, per_pass) if splits_lobe(job) and not brute else per_pass
@@ -52,7 +59,7 @@ def _per_pass(job: Job, samples: SamplePlan) -> int:
 
 def grating_reads(job: Job, samples: SamplePlan, brute: bool = False) -> int:
     """A pass's reads along the curve a grating's orders leave by (0: not read so)."""
-    return _per_pass(job, samples) if reads_orders(job) and not brute else 0
+    return _per_pass(job, samples) if orders_read(job, brute) else 0
 
 
 def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
@@ -68,12 +75,11 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
     # samples (spectral ones).
     three_lobes = material.iridescence == "rotation" and material.mdf == "ashikhmin" and shared
     film_per_pixel = material.iridescence == "thin-film" and film_shared
-    orders = reads_orders(job) and not brute
     return {"ENVIRONMENT_MAP": True, "ENV_SAMPLES": samples_per_pass(job, samples, brute),
             "ENV_BRUTE": brute, "ENV_BACKDROP": bool(job.environment_background),
             # The brute-force reference samples the whole multi-peak lobe at every wavelength.
             "ENV_ENVELOPE": splits_lobe(job) and not brute,
-            "ENV_GRATING_ORDERS": orders,
+            "ENV_GRATING_ORDERS": orders_read(job, brute),
             "ENV_GRATING_READS": grating_reads(job, samples, brute) or False,
             "FILM_PER_PIXEL": film_per_pixel,
             "ENV_RGB_LOBES": three_lobes and job.wavelengths > 0,
@@ -129,7 +135,7 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
     }
-    if reads_orders(job) and not brute:
+    if orders_read(job, brute):
         values.update(grating_uniforms())
     if len(environment.light_directions):
         # The map turns by +rotation about +y (atan2(z, x) grows): its lights with it.

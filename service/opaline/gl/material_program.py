@@ -26,10 +26,9 @@ import math
 
 import numpy as np
 
-from opaline.gl import heightfield
+from opaline.gl import environment_light, heightfield
 from opaline.gl.uniforms import Uniforms
 from opaline.model import coat, grating, metals, stack_film, visible
-from opaline.model.environment_light import reads_orders
 from opaline.model.params import Material
 from opaline.model.presets import Preset
 from opaline.model.request import Job
@@ -127,8 +126,8 @@ def uses_transmission(material: Material, preset: Preset) -> bool:
 def surface_defines(job: Job, preset: Preset, brute: bool = False) -> Defines:
     """The surface program's defines: the material's, then the scene's (no key in common);
     ``brute``: the brute-force reference, which samples a grating's whole lobe."""
-    orders_read = reads_orders(job) and not brute
-    defines = material_defines(job.material, job.wavelengths, job.aa, orders_read)
+    defines = material_defines(job.material, job.wavelengths, job.aa,
+                               environment_light.orders_read(job, brute))
     defines["NORMAL_MAP"] = preset.normal_map is not None
     defines["TANGENT_CONCENTRIC"] = preset.tangents == "concentric"
     defines["LIGHT_COUNT"] = len(preset.lights)
