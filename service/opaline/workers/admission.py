@@ -83,6 +83,7 @@ class CostModel:
     # by an environment was timed with it, which a job's own must not add again.
     light_load: dict[str, float] = field(default_factory=dict)
     calibrated: bool = False
+    _parts: set[int] = field(default_factory=set, repr=False)  # the calibration's, in
     _warm: OrderedDict[Hashable, None] = field(default_factory=OrderedDict, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -127,13 +128,17 @@ class CostModel:
         return SAFETY * (self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral))
 
     def _slowest(self) -> Coefficients:
-        if not self.labels:
+        """What a label with no timing of its own is priced by: the slowest calibrated
+        label, or the built-in guess while a part of the calibration is still out (the
+        parts in may all be cheap presets)."""
+        if not self.calibrated or not self.labels:
             return Coefficients(DEFAULT_PER_UNIT_S, DEFAULT_PER_WAVELENGTH)
         return Coefficients(max(c.per_unit_s for c in self.labels.values()),
                             max(c.per_wavelength for c in self.labels.values()))
 
     def calibrate(self, report: bytes) -> None:
-        """Fit the coefficients from ``CalibrateTask``'s JSON answer."""
+        """Fit the coefficients from a ``CalibrateTask``'s JSON answer, one part of the
+        calibration (the whole where it names none): calibrated once every part is in."""
         data = json.loads(report)
         overhead = max(0.0, float(data["overhead_s"]))
         units, wavelengths = float(data["units"]), float(data["wavelengths"])
@@ -147,8 +152,13 @@ class CostModel:
         cold = {label: max(0.0, float(s)) for label, s in data.get("cold_s", {}).items()}
         loads = {label: max(1.0, float(n)) for label, n in data.get("light_load", {}).items()}
         with self._lock:
-            self.overhead_s, self.labels, self.calibrated = overhead, labels, True
-            self.cold, self.light_load = cold, loads
+            # Each part times the overhead again; the largest stands, as it adds to every job.
+            self.overhead_s = max(overhead, self.overhead_s) if self._parts else overhead
+            self._parts.add(int(data.get("part", 0)))
+            self.labels.update(labels)
+            self.cold.update(cold)
+            self.light_load.update(loads)
+            self.calibrated = len(self._parts) >= int(data.get("parts", 1))
             self.calibration_wavelengths = int(wavelengths)
 
     def describe(self) -> dict[str, object]:

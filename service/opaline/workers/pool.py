@@ -32,7 +32,7 @@ from opaline.workers.errors import (
 )
 from opaline.workers.job import Job, Store
 from opaline.workers.slot import Slot
-from opaline.workers.tasks import CalibrateTask, Task
+from opaline.workers.tasks import Task, calibration_tasks
 
 log = logging.getLogger(__name__)
 REAP_S = 0.1
@@ -79,7 +79,7 @@ class WorkerPool:
             log.error("no render worker has a GL context: %s",
                       "; ".join(s.error or s.state for s in self.slots))
             return
-        tasks: list[Task | None] = [self.warmup, CalibrateTask() if self.calibrate else None]
+        tasks: list[Task | None] = [self.warmup, *(calibration_tasks() if self.calibrate else [])]
         with self._cond:  # first in the queue, never expiring, counted in the backlog
             for task in filter(None, tasks):
                 job = Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf,
