@@ -27,7 +27,8 @@ from opaline.local.export import export_material  # noqa: E402
 from opaline.local.pipeline import LocalRenderer  # noqa: E402
 from opaline.model.params import RenderRequest  # noqa: E402
 from opaline.workers.admission import CostModel  # noqa: E402
-from opaline.workers.tasks import CalibrateTask, ImageTask  # noqa: E402
+from opaline.workers.calibration import CalibrateTask  # noqa: E402
+from opaline.workers.tasks import ImageTask  # noqa: E402
 from report import save  # noqa: E402
 
 PRESETS = ("sphere", "nacre-film", "soap-bubble", "anodised-titanium", "cd-rom-grating",

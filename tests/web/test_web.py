@@ -21,7 +21,7 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-sync"]
 # The longest any one step may take in the browser. The first preview waits out the
 # start-up calibration's predicted time (its Retry-After): 4 renders a preset at the
-# uncalibrated cost model, 14 s for 17 presets (tasks.CalibrateTask.units), which had
+# uncalibrated cost model, 14 s for 17 presets (calibration.CalibrateTask.units), which had
 # outgrown 15 s with the page's own work.
 WAIT_MS = 30_000
 # The service's start-up: worker thread, GL context, warm-up, calibration (with an empty

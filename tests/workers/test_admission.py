@@ -15,13 +15,13 @@ from opaline.model.params import RenderRequest
 from opaline.model.presets import get_preset
 from opaline.pipeline.prepare import prepare
 from opaline.workers.admission import CostModel, TooSlow, admit
-from opaline.workers.tasks import (
+from opaline.workers.calibration import (
     LABELS_PER_CALIBRATION,
     CalibrateTask,
-    ImageTask,
     calibrated_labels,
     calibration_tasks,
 )
+from opaline.workers.tasks import ImageTask
 
 # CalibrateTask's answer as a worker gave it for 'sphere' (192², 2 samples; 0 and 16
 # wavelengths) and the tiny render's overhead.

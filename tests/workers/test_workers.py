@@ -34,7 +34,6 @@ def make_pool():
 
     def make(**kwargs) -> WorkerPool:
         kwargs.setdefault("factory", null_renderer)
-        kwargs.setdefault("calibrate", False)
         pool = WorkerPool(**kwargs)
         pool.start()
         pools.append(pool)
@@ -248,7 +247,7 @@ def test_workers_die_with_their_parent(tmp_path):
         from worker_helpers import null_renderer
         from opaline.workers.pool import WorkerPool
         if __name__ == "__main__":
-            pool = WorkerPool(null_renderer, workers=2, calibrate=False)
+            pool = WorkerPool(null_renderer, workers=2)
             pool.start()
             print(" ".join(str(w["pid"]) for w in pool.status()), flush=True)
             time.sleep(60)

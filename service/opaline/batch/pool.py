@@ -49,7 +49,7 @@ class GLProcesses:
         factory = RendererFactory(backend, environments_dir=setting("environments_dir"))
         self.pool = WorkerPool(factory, workers=jobs, queue_size=1 << 20,
                                deadline_s=NO_DEADLINE_S, render_timeout_s=RENDER_LIMIT_S,
-                               lp_threads=max(1, (os.cpu_count() or 1) // jobs), calibrate=False)
+                               lp_threads=max(1, (os.cpu_count() or 1) // jobs))
         self.pool.start()
 
     def submit(self, task: Task) -> Future[Outcome]:

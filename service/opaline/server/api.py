@@ -49,6 +49,7 @@ from opaline.server.statestore import LocalState, StateStore
 from opaline.server.turntable_jobs import Turntables
 from opaline.server.turntable_routes import router as turntable_router
 from opaline.settings import Settings, get_settings, memory_budget_bytes
+from opaline.workers.calibration import calibration_tasks
 from opaline.workers.factory import RendererFactory
 from opaline.workers.pool import WorkerPool
 from opaline.workers.tasks import PRIVATE, ImageTask
@@ -214,7 +215,8 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
         render_timeout_s=settings.render_timeout_s, max_renders=settings.worker_max_renders,
         max_rss_bytes=settings.worker_max_rss_mb * 1024 * 1024, lp_threads=lp_threads,
         cache=cache, on_rendered=lambda label, s: metrics.render_seconds.labels(label).observe(s),
-        warmup=warmup_task() if settings.warmup else None, calibrate=settings.calibrate)
+        startup=[*([warmup_task()] if settings.warmup else []),
+                 *(calibration_tasks() if settings.calibrate else [])])
     metrics.watch(pool.depth, lambda: cache.size_bytes)
     metrics.watch_pool(pool.counters, lambda: cache.evictions)
     metrics.watch_connections(CONNECTION_STATS)

@@ -25,5 +25,4 @@ def check_lane(settings: Settings) -> WorkerPool:
                       deadline_s=settings.deadline_s,
                       render_timeout_s=settings.render_timeout_s,
                       max_renders=settings.worker_max_renders,
-                      max_rss_bytes=settings.worker_max_rss_mb * 1024 * 1024, lp_threads=1,
-                      warmup=None, calibrate=False)
+                      max_rss_bytes=settings.worker_max_rss_mb * 1024 * 1024, lp_threads=1)

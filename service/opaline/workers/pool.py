@@ -16,7 +16,7 @@ import threading
 import time
 import uuid
 from collections import Counter, deque
-from collections.abc import Awaitable, Callable
+from collections.abc import Awaitable, Callable, Sequence
 from concurrent.futures import Future
 from typing import Any
 
@@ -32,27 +32,27 @@ from opaline.workers.errors import (
 )
 from opaline.workers.job import Job, Store
 from opaline.workers.slot import Slot
-from opaline.workers.tasks import Task, calibration_tasks
+from opaline.workers.tasks import Task
 
 log = logging.getLogger(__name__)
 REAP_S = 0.1
 
 
 class WorkerPool:
-    """``workers`` processes behind a queue of ``queue_size`` jobs."""
+    """``workers`` processes behind a queue of ``queue_size`` jobs; ``startup``: the jobs
+    that run first (warm-up, calibration), never expiring, before the pool is ready."""
 
     def __init__(self, factory: Callable[[], Any], workers: int = 1, queue_size: int = 32,
                  deadline_s: float = 10.0, render_timeout_s: float = 30.0,
                  max_renders: int = 1000, max_rss_bytes: int = 1 << 30,
                  lp_threads: int | None = None, cache: Store | None = None,
                  on_rendered: Callable[[str, float], None] | None = None,
-                 warmup: Task | None = None, calibrate: bool = True,
-                 start_timeout_s: float = 60.0) -> None:
+                 startup: Sequence[Task] = (), start_timeout_s: float = 60.0) -> None:
         self.factory, self.size, self.queue_size = factory, workers, queue_size
         self.deadline_s, self.render_timeout_s = deadline_s, render_timeout_s
         self.max_renders, self.max_rss_bytes = max_renders, max_rss_bytes
         self.lp_threads, self.cache, self.on_rendered = lp_threads, cache, on_rendered
-        self.warmup, self.calibrate, self.start_timeout_s = warmup, calibrate, start_timeout_s
+        self.startup, self.start_timeout_s = startup, start_timeout_s
         self.cost = CostModel()
         self.counters: Counter[str] = Counter()
         self.stopping = True
@@ -79,9 +79,8 @@ class WorkerPool:
             log.error("no render worker has a GL context: %s",
                       "; ".join(s.error or s.state for s in self.slots))
             return
-        tasks: list[Task | None] = [self.warmup, *(calibration_tasks() if self.calibrate else [])]
         with self._cond:  # first in the queue, never expiring, counted in the backlog
-            for task in filter(None, tasks):
+            for task in self.startup:
                 job = Job(next(self._ids), uuid.uuid4().hex, task, task.label, math.inf,
                           self.cost.predict(*task.units()))
                 self._enqueue(job)
