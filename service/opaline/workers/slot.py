@@ -28,7 +28,7 @@ log = logging.getLogger(__name__)
 SPAWN = multiprocessing.get_context("spawn")
 POLL_S = 0.05
 RESPAWN_BACKOFF_S = (0.5, 1.0, 2.0, 5.0, 10.0)
-HUNG_AFTER_S = 2.0  # four missed heartbeats and no CPU time used meanwhile
+HUNG_AFTER_S = 2.0  # 4 missed heartbeats and no CPU, in a job (checked after its time limit)
 
 
 class Supervisor(Protocol):
@@ -185,10 +185,6 @@ class Slot:
                 self.replace("died")
                 self.pool.fail(job, Unavailable("the render worker died; try again"))
                 return None
-            if self.hung():
-                self.replace("hung")
-                self.pool.fail(job, Unavailable("the render worker stopped answering; try again"))
-                return None
             if time.monotonic() > limit:
                 self.pool.counters["watchdog_kills"] += 1
                 log.error("%s: job %s (%s) ran past %g s; killing pid %d", self.name, job.key,
@@ -199,6 +195,10 @@ class Slot:
                     if limit_s < self.pool.render_timeout_s else DeadlineExceeded(
                     f"the render ran past the {self.pool.render_timeout_s:g} s limit"))
                 return None
+            if self.hung():
+                self.replace("hung")
+                self.pool.fail(job, Unavailable("the render worker stopped answering; try again"))
+                return None
         try:
             reply: child.Reply = self.conn.recv()
             return reply
@@ -208,13 +208,13 @@ class Slot:
             return None
 
     def hung(self) -> bool:
-        """No heartbeat for ``HUNG_AFTER_S`` and no CPU used (a GIL-holding draw burns CPU)."""
+        """No heartbeat nor CPU (a GIL-holding draw burns CPU) for ``HUNG_AFTER_S`` of a job."""
         if self.process is None or self.heartbeat is None:
             return False
         now, ticks = time.monotonic(), child.cpu_ticks(self.process.pid)
         if ticks != self._cpu[0]:
             self._cpu = (ticks, now)
-        if now - max(self.heartbeat.value, self._cpu[1]) <= HUNG_AFTER_S:
+        if now - max(self.heartbeat.value, self._cpu[1], self.job_started) <= HUNG_AFTER_S:
             return False
         log.error("%s: pid %d hung (no heartbeat, no CPU)", self.name, self.process.pid)
         return True
