@@ -113,8 +113,12 @@ def test_the_cost_model_is_calibrated_once_every_part_is_in():
     is priced by the built-in guess, not by the cheap presets timed so far."""
     found = CostModel()
     guess = found.predict("morpho", 1e5, 0)
-    found.calibrate(json.dumps({**CALIBRATION, "part": 0, "parts": 2}).encode())
+    found.calibrate(json.dumps({**CALIBRATION, "part": 0, "parts": 2,
+                                "cold_s": {"sphere": 0.001}}).encode())
     assert not found.calibrated
+    morpho = ImageTask(prepare(CalibrateTask._request(get_preset("morpho"), 0),
+                               local_context(None)))
+    assert found.predict_task(morpho) >= found.predict(*morpho.units()) + 1.5 * 0.1
     assert found.predict("morpho", 1e5, 0) == pytest.approx(guess, rel=0.2)
     sphere = found.predict("sphere", 1e5, 0)
     assert sphere < guess / 2

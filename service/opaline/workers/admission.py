@@ -98,7 +98,7 @@ class CostModel:
         label = task.cold_label()
         with self._lock:
             cold = key not in self._warm
-            slowest = max(self.cold.values(), default=DEFAULT_COLD_S)
+            slowest = self._slowest_cold()
             cold_s = slowest if label is None else self.cold.get(label, slowest)
         return self.predict(*units) + (SAFETY * cold_s if cold else 0.0)
 
@@ -135,6 +135,13 @@ class CostModel:
             return Coefficients(DEFAULT_PER_UNIT_S, DEFAULT_PER_WAVELENGTH)
         return Coefficients(max(c.per_unit_s for c in self.labels.values()),
                             max(c.per_wavelength for c in self.labels.values()))
+
+    def _slowest_cold(self) -> float:
+        """The first-render cost of a label with none of its own: the slowest measured,
+        and not under the built-in guess while a part of the calibration is still out."""
+        measured = list(self.cold.values())
+        return max(measured if self.calibrated else [*measured, DEFAULT_COLD_S],
+                   default=DEFAULT_COLD_S)
 
     def calibrate(self, report: bytes) -> None:
         """Fit the coefficients from a ``CalibrateTask``'s JSON answer, one part of the
