@@ -18,6 +18,7 @@ import numpy as np
 
 from opaline.scene import generators
 from opaline.scene.mesh import Mesh, grid_indices, make_mesh
+from opaline.scene.rings import ring_plan, zip_rings
 from opaline.scene.waves import DEFAULT_WAVES, RESOLUTION, wave_height, wavy_surface
 
 __all__ = ["DEFAULT_WAVES", "KINDS", "Mesh", "RESOLUTION", "annulus", "arguments", "box",
@@ -79,7 +80,10 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     """Flat ring in the xz plane facing +y, the disc of the paper's CD figure.
 
     The hole is real (no triangles inside ``inner_radius``) so nothing is shaded
-    where a CD has none. The tangent is concentric, ``(-z, 0, x) / r``, because
+    where a CD has none. Both edges are polygons of ``segments`` vertices; inside,
+    the rings are coarser (``scene.rings``: a uniform grid's slivers made the
+    rasteriser shade the same pixels several times), with ``rings`` bands over the
+    middle. The tangent is concentric, ``(-z, 0, x) / r``, because
     the grooves run along the tracks; ``uv`` is the planar projection of
     ``(x, z)`` from ``[-outer, outer]`` onto ``[0, 1]``.
     """
@@ -90,11 +94,12 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     segments = generators.integer("segments", segments, *SEGMENTS)
     rings = generators.integer("rings", rings, *RINGS)
 
-    # Angular columns wrap around: the uv is planar, so no seam vertex is needed.
-    r = np.linspace(inner, outer, rings + 1)
-    alpha = np.arange(segments) * (TWO_PI / segments)
-    rr, aa = np.meshgrid(r, alpha, indexing="ij")
-    rr, aa = rr.ravel(), aa.ravel()
+    # Every ring starts at angle 0; the uv is planar, so no seam vertex is needed.
+    plan = ring_plan(inner, outer, segments, rings)
+    counts = np.array([count for _, count in plan])
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    rr = np.repeat([radius for radius, _ in plan], counts)
+    aa = np.concatenate([np.arange(count) * (TWO_PI / count) for count in counts])
     x, z = rr * np.cos(aa), rr * np.sin(aa)
     zeros = np.zeros_like(x)
 
@@ -102,15 +107,9 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     normals = np.stack([zeros, np.ones_like(x), zeros], 1)
     tangents = np.stack([-z, zeros, x], 1) / rr[:, None]
     uvs = np.stack([(x / outer + 1.0) * 0.5, (z / outer + 1.0) * 0.5], 1)
-
-    # Row i = radius, column j = angle: (b-a)×(c-a) = (angle direction) × (radial
-    # direction) = +y, so (a, b, c) and (b, d, c) are counter-clockwise from +y.
-    rows, cols = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
-    i, j = rows.ravel(), cols.ravel()
-    jn = (j + 1) % segments
-    a, b = i * segments + j, i * segments + jn
-    c, d = a + segments, b + segments
-    indices = np.concatenate([np.stack([a, b, c], 1), np.stack([b, d, c], 1)])
+    indices = [triangle for k in range(len(plan) - 1)
+               for triangle in zip_rings(int(starts[k]), int(counts[k]), int(starts[k + 1]),
+                                         int(counts[k + 1]))]
     return make_mesh(positions, normals, tangents, uvs, indices)
 
 
