@@ -66,7 +66,8 @@ def test_mesh_renders_are_timed_under_the_preset_they_name(client):
 @pytest.mark.gl
 def test_folder_meshes_by_name(client):
     assert client.get(f"/v1/render?mesh=shelf.ply&{SMALL}").status_code == 200
-    for name in ("../shelf.ply", "missing.ply", "0" * 32):
+    # 300 characters: longer than any file name can be (ENAMETOOLONG was a 500).
+    for name in ("../shelf.ply", "missing.ply", "0" * 32, "a" * 300):
         answer = client.get(f"/v1/render?mesh={name}&{SMALL}")
         assert answer.status_code == 404 and "POST /v1/meshes" in answer.json()["detail"][0]
 

@@ -157,7 +157,11 @@ class MeshStore:
         elif self.folder is not None and "/" not in name and "\\" not in name \
                 and not name.startswith("."):
             path = Path(self.folder) / name
-            if path.is_file():
+            try:
+                found = path.is_file()
+            except OSError:  # a name no file can have (over the file system's 255 bytes)
+                found = False
+            if found:
                 return path, self._folder_digest(path)
         raise UnknownMesh(name)
 
