@@ -90,6 +90,27 @@ def test_hdr_files_from_the_environments_folder(tmp_path, suffix):
         environments.environment_lights(f"bad{suffix}", 8, folder=tmp_path)
 
 
+def test_files_that_cannot_be_read_are_refused_by_name_without_the_folder(tmp_path):
+    """A Radiance header declaring 2M × 2M texels (OpenCV raised its own error, which ended
+    the worker: a 500 and a restart per request), an EXR without R, G and B, an empty EXR:
+    each an EnvironmentMapError that names the file and not the server's folder."""
+    exr = pytest.importorskip("OpenEXR")
+    pytest.importorskip("cv2")
+    (tmp_path / "huge.hdr").write_bytes(
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2000000 +X 2000000\n")
+    header = {"compression": exr.ZIP_COMPRESSION, "type": exr.scanlineimage}
+    with exr.File(header, {"Y": np.ones((4, 8), dtype=np.float32)}) as file:
+        file.write(str(tmp_path / "grey.exr"))
+    (tmp_path / "empty.exr").write_bytes(b"")
+    for name, why in (("huge.hdr", "OpenCV refused it"), ("grey.exr", "no R, G and B channels"),
+                      ("empty.exr", "cannot read")):
+        with pytest.raises(environments.EnvironmentMapError) as caught:
+            environments.read_file(tmp_path / name)
+        message = str(caught.value)
+        assert message.startswith(f"environment {name}: ") and why in message, message
+        assert str(tmp_path) not in message
+
+
 @pytest.mark.gl
 def test_background_shows_the_environment(local):
     """With environment_background the pixels around the object are the map's radiance

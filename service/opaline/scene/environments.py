@@ -81,25 +81,37 @@ def read_file(path: Path) -> np.ndarray:
                 channels = exr.channels()
                 if "RGB" in channels:
                     image = np.asarray(channels["RGB"].pixels, dtype=np.float32)
-                else:
+                elif all(c in channels for c in "RGB"):
                     image = np.stack([np.asarray(channels[c].pixels, dtype=np.float32)
                                       for c in "RGB"], -1)
+                else:
+                    raise ValueError(f"no R, G and B channels (it has {', '.join(channels)})")
         else:
-            import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
-
-            decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-            if decoded is None:
-                raise ValueError("not a Radiance .hdr image")
-            image = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
+            image = _read_radiance(path)
     except ImportError as exc:
         raise EnvironmentMapError(f"environment {path.name}: reading {suffix} files needs "
                                   f"{exc.name}, a dependency of opaline: reinstall it") from None
     except (OSError, ValueError, KeyError, RuntimeError) as exc:
-        raise EnvironmentMapError(f"environment {path.name}: cannot read: {exc}") from None
+        # The folder is the server's business: the message names the file, not its path.
+        reason = str(exc).replace(str(path), path.name)
+        raise EnvironmentMapError(f"environment {path.name}: cannot read: {reason}") from None
     if image.ndim != 3 or image.shape[2] < 3:
         raise EnvironmentMapError(f"environment {path.name}: expected finite RGB, got "
                                 f"shape {image.shape}")
     return sanitised(path.name, image[..., :3])
+
+
+def _read_radiance(path: Path) -> np.ndarray:
+    import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
+
+    try:
+        decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
+        raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
+    if decoded is None:
+        raise ValueError("not a Radiance .hdr image")
+    image: np.ndarray = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
+    return image
 
 
 def sanitised(name: str, radiance: np.ndarray) -> np.ndarray:
