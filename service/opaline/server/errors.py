@@ -24,6 +24,7 @@ from starlette.exceptions import HTTPException
 from starlette.requests import ClientDisconnect
 
 from opaline.errors import PublicError
+from opaline.model.messages import UNKNOWN_NAMED
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.pipeline.limits import LimitError as LimitError
 from opaline.pipeline.prepare import UnknownEnvironment as UnknownEnvironment
@@ -131,8 +132,13 @@ def _validation_fields(errors: Sequence[Mapping[str, Any]], model: type[BaseMode
     """``fields`` of a 422: each error about a field, with the line ``lines_of`` gives it
     alone (the lines are written one per error, so they are those of ``detail``)."""
     found: list[dict[str, str]] = []
+    unknown = 0
     for err in errors:
         name = _field_of(tuple(err.get("loc", ())))
+        if err.get("type") == "extra_forbidden":
+            unknown += 1
+            if unknown > UNKNOWN_NAMED:  # as many as detail names; it counts the rest
+                continue
         if name is not None:
             found.extend({"field": name, "message": line} for line in lines_of([err], model))
     return found
