@@ -77,6 +77,12 @@ def test_http_turntable_with_progress(backend):
         over = client.post("/v1/turntables", json={"preset": "sphere", "frames": 9,
                                                    "width": 64, "height": 64, "quality": "draft"})
         assert over.status_code == 422 and "frames" in over.json()["detail"][0]
+        # The turntable's own fields' ranges, as a render's are given (they said only
+        # "less than or equal to 360", or nothing).
+        for field, line in (({"frames": 361}, "frames=361 is out of range: allowed [2 … 360]"),
+                            ({"fps": "x"}, "(allowed [1 … 60])")):
+            bad = client.post("/v1/turntables", json={"preset": "sphere", **field})
+            assert bad.status_code == 422 and line in bad.json()["detail"][0], bad.json()
         lax = client.post("/v1/turntables", json={"preset": "sphere", "light_elevation": False})
         assert lax.status_code == 422 and lax.json()["error"] == "invalid"  # strict, as render
         started = client.post("/v1/turntables", json={

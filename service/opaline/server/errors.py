@@ -26,6 +26,7 @@ from starlette.requests import ClientDisconnect
 from opaline.errors import PublicError
 from opaline.model.messages import UNKNOWN_NAMED
 from opaline.model.params import RenderRequest, describe_errors
+from opaline.model.turntable import TurntableRequest
 from opaline.pipeline.limits import LimitError as LimitError
 from opaline.pipeline.prepare import UnknownEnvironment as UnknownEnvironment
 from opaline.server.docs import SECURITY_HEADERS
@@ -162,10 +163,17 @@ def validation_code(errors: list[Any]) -> str:
     return "budget_with_tier" if kinds == {"budget_with_tier"} else "invalid"
 
 
+def _model_for(path: str) -> type[BaseModel]:
+    """The model a route's fields come from, whose ranges its error lines give."""
+    if path.startswith("/v1/mdf"):
+        return MdfQuery
+    return TurntableRequest if path.startswith("/v1/turntables") else RenderRequest
+
+
 async def on_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
     code = validation_code(list(exc.errors()))
     request.app.state.metrics.reject(code)
-    model = MdfQuery if request.url.path.startswith("/v1/mdf") else RenderRequest
+    model = _model_for(request.url.path)
     errors = list(exc.errors())
     return problem(422, code, _validation_lines(errors, model),
                    fields=_validation_fields(errors, model, _validation_lines))
@@ -183,8 +191,9 @@ async def on_invalid_model(request: Request, exc: ValidationError) -> JSONRespon
     """A model that a route validated itself (a strictly parsed body)."""
     reason = validation_code(exc.errors())
     request.app.state.metrics.reject(reason)
-    return problem(422, reason, describe_errors(exc),
-                   fields=_validation_fields(exc.errors(), RenderRequest, describe_errors))
+    model = _model_for(request.url.path)
+    return problem(422, reason, describe_errors(exc, model),
+                   fields=_validation_fields(exc.errors(), model, describe_errors))
 
 
 async def on_http_error(request: Request, exc: HTTPException) -> JSONResponse:
