@@ -31,12 +31,18 @@ vec3 specular_rgb_lobes(Material mat, float vh, float nl, float nv) {
 //   spectral evaluation, as one light does), each band box-filtered over the share of
 //   the disc its wavelength's samples stand for. None are drawn (ENV_SAMPLES 0) when
 //   that filter leaves them under 5 % of the envelope anywhere on the lobe.
+// * The bands' mean over the disc moves to the envelope (½·hz·(1 + mean)), the samples
+//   carry band − mean: near mu_f = 0 the band is a constant 1 that few samples a
+//   wavelength drew as colour noise over a smooth lobe.
+uniform float u_env_band_mean;
+
 vec3 specular_bands(Material mat, vec3 hl, float vh, float nl, float nv, int first,
                     float cell) {
     vec3 d = vec3(0.0);
     for (int i = first; i < WAVELENGTHS; i += max(ENV_SAMPLES, 1)) {
-        d += u_spectral_weight[i] * multipeak_band_cell(
-            rotate_half(real2(hl.xy), u_spectral_rotation[i]), mat.mu_f, mat.alpha, mat.beta, cell);
+        d += u_spectral_weight[i] * (multipeak_band_cell(
+            rotate_half(real2(hl.xy), u_spectral_rotation[i]), mat.mu_f, mat.alpha, mat.beta, cell)
+            - u_env_band_mean);
     }
     return mat.ks * (0.5 * hl.z) * d * microfacet_factor(mat, vh, nl, nv) * nl;
 }
@@ -58,7 +64,8 @@ float envelope_albedo(Material mat, float nv) {
 vec3 specular_envelope(Material mat, Environment env, vec3 n, vec3 v) {
     float nv = clamp(dot(n, v), 0.0, 1.0);
     vec3 d = normalize(n + 0.5 * (2.0 * dot(n, v) * n - v));
-    return mat.ks * envelope_albedo(mat, nv) * environment_irradiance(env, d) / PI;
+    return mat.ks * envelope_albedo(mat, nv) * (1.0 + u_env_band_mean)
+           * environment_irradiance(env, d) / PI;
 }
 #endif
 

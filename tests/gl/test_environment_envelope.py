@@ -30,7 +30,8 @@ MULTIPEAK = Material(mdf="multipeak", mu_f=8.5, alpha=2.0, beta=1.2, theta1=0.1,
 @pytest.mark.parametrize("rotation", [0.0, 2.0])
 def test_multipeak_envelope_agrees(renderer, f0, rotation):
     """specular_envelope (the multi-peak lobe's envelope, ENV_ENVELOPE) is the twin's
-    ks·A(n·v)·E(d)/π, d = envelope.dominant(n, v) turned into the map's frame."""
+    ks·A(n·v)·(1 + the bands' mean)·E(d)/π, d = envelope.dominant(n, v) turned into the
+    map's frame."""
     from opaline.model import envelope
 
     rng = np.random.default_rng(9)
@@ -49,8 +50,9 @@ def test_multipeak_envelope_agrees(renderer, f0, rotation):
     c, s = math.cos(rotation), math.sin(rotation)
     m = np.stack([c * d[:, 0] + s * d[:, 2], d[:, 1], c * d[:, 2] - s * d[:, 0]], -1)
     nv = (n.astype(np.float64) * v).sum(1)
-    expected = (mat.ks * envelope.albedo(nv, f0)[:, None] * irr.irradiance(environment[1], m)
-                / math.pi)
+    mean = envelope.band_mean(mat.mu_f, mat.alpha, mat.beta, envelope.cell_side(1))
+    expected = (mat.ks * envelope.albedo(nv, f0)[:, None] * (1.0 + mean)
+                * irr.irradiance(environment[1], m) / math.pi)
     assert np.isfinite(gl).all()
     assert float(np.abs(gl - expected).max()) <= 1e-5 * float(expected.max())
 
@@ -93,10 +95,11 @@ def hemisphere_integral(mat: Material, n, t, v, wavelengths: int) -> np.ndarray:
     return result
 
 
-def test_split_estimate_converges_under_a_constant_map(renderer, tmp_path):
+def grey_map_passes(renderer, tmp_path, mat: Material, level: float, passes: int):
+    """The lobe probe's specular estimate at three (n, t, v) under a constant map:
+    (passes, 3, 4), and the cases."""
     import cv2
 
-    level = 0.5
     cv2.imwrite(str(tmp_path / "grey.hdr"), np.full((32, 64, 3), level, dtype=np.float32))
     n = np.array([[0.0, 0.0, 1.0], [0.3, 0.2, 0.93], [0.0, 0.6, 0.8]])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
@@ -107,11 +110,16 @@ def test_split_estimate_converges_under_a_constant_map(renderer, tmp_path):
     maps = EnvironmentMaps(renderer.ctx, tmp_path)
     try:
         uploaded = maps.get("grey.hdr")
-        passes = renderer.probes.lobe(SLOW, "specular", (as_f32(n), as_f32(t), as_f32(v)),
-                                      (uploaded.texture, uploaded.irradiance), samples=4,
-                                      passes=512, brute=False, wavelengths=16)
+        return renderer.probes.lobe(mat, "specular", (as_f32(n), as_f32(t), as_f32(v)),
+                                    (uploaded.texture, uploaded.irradiance), samples=4,
+                                    passes=passes, brute=False, wavelengths=16), (n, t, v)
     finally:
         maps.release()
+
+
+def test_split_estimate_converges_under_a_constant_map(renderer, tmp_path):
+    level = 0.5
+    passes, (n, t, v) = grey_map_passes(renderer, tmp_path, SLOW, level, 512)
     estimate = passes[..., :3].astype(np.float64).mean(0)
     error = passes[..., :3].std(0, ddof=1) / math.sqrt(passes.shape[0])
     expected = level * np.array([hemisphere_integral(SLOW, *case, 16)
@@ -119,3 +127,23 @@ def test_split_estimate_converges_under_a_constant_map(renderer, tmp_path):
     assert np.isfinite(passes).all()
     bound = 4.0 * error + 5e-3 * expected.max(1, keepdims=True)
     assert np.all(np.abs(estimate - expected) <= bound), (estimate, expected, bound)
+
+
+@pytest.mark.parametrize("update", [{"mu_f": 0.0}, {"alpha": 0.0, "beta": 0.0}],
+                         ids=["mu_f=0", "alpha=beta=0"])
+def test_a_constant_band_is_the_envelope_s_and_leaves_no_grain(renderer, tmp_path, update):
+    """With no phase (mu_f = 0, or α = β = 0) the band is a constant 1 and D = hz: its mean
+    goes to the envelope and the samples carry nothing, so every pass gives the same
+    estimate, the integral under a constant map. (Sampling the constant drew the colour
+    noise a review found on the sphere at mu_f = 0 in the studio, even at high.)"""
+    from opaline.model import envelope
+
+    mat = SLOW.model_copy(update=update)
+    assert envelope.band_mean(mat.mu_f, mat.alpha, mat.beta) == 1.0
+    level = 0.5
+    passes, (n, t, v) = grey_map_passes(renderer, tmp_path, mat, level, 8)
+    rgb = passes[..., :3].astype(np.float64)
+    assert float(np.abs(rgb - rgb[0]).max()) <= 1e-6 * float(np.abs(rgb).max())
+    expected = level * np.array([hemisphere_integral(mat, *case, 16)
+                                 for case in zip(n, t, v, strict=True)])
+    np.testing.assert_allclose(rgb[0], expected, rtol=5e-3)

@@ -19,6 +19,7 @@ from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
 from opaline.model import grating, visible
+from opaline.model.envelope import band_mean, cell_side
 from opaline.model.environment_light import band_samples, reads_orders, splits_lobe
 from opaline.model.params import Material
 from opaline.model.request import Job
@@ -134,6 +135,9 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_coat_total": float(per_pixel if brute else samples.passes * samples.factor ** 2),
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
+        # The bands' filtered mean at the cell each wavelength's samples stand for.
+        "u_env_band_mean": band_mean(material.mu_f, material.alpha, material.beta,
+                                     cell_side(job.samples)),
     }
     if orders_read(job, brute):
         values.update(grating_uniforms())

@@ -17,6 +17,7 @@ import numpy as np
 from opaline.gl import environment_light, material_program, texture_units, uniforms
 from opaline.gl.buffers import read_float
 from opaline.gl.resources import Resources
+from opaline.model.envelope import band_mean, cell_side
 from opaline.model.params import Material
 
 # glsl/lobe_probe.glsl's modes: what each case evaluates.
@@ -161,7 +162,9 @@ class Probes:
                        "u_env_intensity": intensity, "u_env_total": float(samples * passes),
                        # The coat's, one a pass (all of a pass's in the brute force).
                        "u_env_coat_total": float((samples if brute else 1) * passes),
-                       "u_env_lobe_rotation": environment_light.lobe_rotations(material)})
+                       "u_env_lobe_rotation": environment_light.lobe_rotations(material),
+                       "u_env_band_mean": band_mean(material.mu_f, material.alpha,
+                                                    material.beta, cell_side(passes))})
         if environment is not None:
             texture, sh = environment
             texture.use(location=texture_units.ENVIRONMENT)

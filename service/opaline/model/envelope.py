@@ -33,6 +33,10 @@ from opaline.model.reference import TWO_PI, sinc_half
 FloatArray = npt.NDArray[np.float64]
 # Below this the filtered bands are dropped: at most this share of the envelope's D.
 BAND_FLOOR = 0.05
+# band_mean's quadrature: exact to ~1e-10 up to this many cycles across the disc, with
+# this many Gauss-Legendre nodes in ρ (and twice as many angles).
+MEAN_CYCLES = 8.0
+MEAN_GRID = 64
 # The direction the envelope's radiance is read about: n + WEIGHT·r, normalised (r the
 # mirror direction). Measured against the brute-force reference (studio and sky, sphere
 # and cd-rom presets) over 0, 0.25, 0.35, 0.5, 0.7 and 1: least FLIP at 0.35-0.5.
@@ -82,15 +86,52 @@ def cell_side(per_wavelength: int) -> float:
     return math.sqrt(math.pi / per_wavelength)
 
 
+def band_mean(mu_f: float, alpha: float, beta: float, cell: float = 0.0) -> float:
+    """The band's mean over the projected disc (where its samples are drawn), filtered
+    as the samples read it (``band_cell`` over ``cell``), which the envelope carries so
+    that the samples carry only band − mean. Any constant keeps the split exact; this
+    one leaves the samples nothing where the band is nearly constant (mu_f near 0, or
+    α = β = 0: band 1, D = hz), where sampling the whole of it drew colour noise over a
+    smooth lobe, and a remainder of mean 0 elsewhere (the filter over a wide cell takes
+    the bands' mean with them: at mu_f 0.5 the unfiltered mean, −0.56, left the samples
+    carrying +0.56 and their noise). By quadrature up to MEAN_CYCLES cycles
+    across the disc, faded to 0 over the next MEAN_CYCLES, where it is within a few
+    hundredths of 0 and the bands' own sampling carries them."""
+    cycles = mu_f * math.sqrt(max(alpha, beta, 0.0))
+    if cycles >= 2 * MEAN_CYCLES:
+        return 0.0
+    # Gauss-Legendre in ρ (weight 2ρ: the disc's area), the midpoint rule in the angle
+    # (periodic, so as exact).
+    nodes, weights = np.polynomial.legendre.leggauss(MEAN_GRID)
+    rho, w = 0.5 * (nodes + 1.0), weights
+    angle = (np.arange(2 * MEAN_GRID) + 0.5) * (math.pi / MEAN_GRID)
+    hx, hy = rho[:, None] * np.cos(angle), rho[:, None] * np.sin(angle)
+    values = band_cell(hx, hy, mu_f, alpha, beta, cell).mean(1)
+    mean = float((w * rho * values).sum())
+    return mean * min(max(2.0 - cycles / MEAN_CYCLES, 0.0), 1.0)
+
+
 def bands_resolved(mu_f: float, alpha: float, beta: float, per_wavelength: int) -> bool:
-    """Whether the filtered bands can exceed BAND_FLOOR anywhere on the lobe. The phase's
-    slope |∇(mu_f·r)| is at least s = mu_f·√min(α, β) (the positive ones), its larger
-    component at least s/√2, and |sinc(x/2)| ≤ 2/x: the product of the two sincs is at
-    most 2√2/(2π·cell·s). With no slope (mu_f or both α, β zero) the band is a constant
-    1, which samples must carry."""
+    """Whether what the samples carry, the filtered band minus ``band_mean``, can exceed
+    BAND_FLOOR anywhere on the lobe; two bounds, the smaller taken:
+
+    - steep bands: the phase's slope |∇(mu_f·r)| is at least s = mu_f·√min(α, β) (the
+      positive ones), its larger component at least s/√2, and |sinc(x/2)| ≤ 2/x: the
+      filtered band is at most 2√2/(2π·cell·s), the remainder that plus |mean|;
+    - slow bands: over the disc the phase spans P = mu_f·√max(α, β) cycles; at P ≤ ½ the
+      band lies in [cos 2πP, 1], and the filter's two sincs, each in [sinc(π·cell·P), 1]
+      while cell·P < 1, scale it by at least sinc²: the filtered band, and so its mean,
+      lie within (1 − cos 2πP) + (1 − sinc²) of each other. At P = 0 (mu_f or α and β
+      zero) that is 0."""
+    cell = cell_side(per_wavelength)
+    mean = band_mean(mu_f, alpha, beta, cell)
+    bounds = []
     steep = [a for a in (alpha, beta) if a > 0.0]
     slope = mu_f * math.sqrt(min(steep)) if steep else 0.0
-    if slope <= 0.0:
-        return True
-    bound = 2.0 * math.sqrt(2.0) / (TWO_PI * cell_side(per_wavelength) * slope)
-    return bound > BAND_FLOOR
+    if slope > 0.0:
+        bounds.append(2.0 * math.sqrt(2.0) / (TWO_PI * cell * slope) + abs(mean))
+    cycles = mu_f * math.sqrt(max(alpha, beta, 0.0))
+    if cycles <= 0.5 and cell * cycles < 1.0:
+        shrink = float(sinc_half(TWO_PI * cell * cycles)) ** 2
+        bounds.append((1.0 - math.cos(TWO_PI * cycles)) + (1.0 - shrink))
+    return min(bounds, default=math.inf) > BAND_FLOOR
