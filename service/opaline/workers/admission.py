@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from opaline.workers.errors import Overloaded, TooSlow, Unavailable
+from opaline.workers.pace import Pace
 
 # Before calibration: about 4× the slowest preset measured on a 2-core llvmpipe machine
 # (oil-slick, 256² draft: 25 ms for 65,536 pixel-samples), and 5% more per wavelength.
@@ -86,6 +87,7 @@ class CostModel:
     _parts: set[int] = field(default_factory=set, repr=False)  # the calibration's, in
     _warm: OrderedDict[Hashable, None] = field(default_factory=OrderedDict, repr=False)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    pace: Pace = field(default_factory=Pace)  # the load since the calibration (workers.pace)
 
     def predict_task(self, task: Any) -> float:
         """``predict`` of the task's units, and its variant's first-render cost if no
@@ -125,7 +127,15 @@ class CostModel:
             units *= max(1.0, light_load / self.light_load.get(label, 1.0))
         growth = (1.0 + wavelengths / GROWTH_W) / (1.0 + self.calibration_wavelengths / GROWTH_W)
         spectral = found.per_wavelength * wavelengths * growth
-        return SAFETY * (self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral))
+        estimate = self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral)
+        return SAFETY * estimate * self.pace.factor()
+
+    def observe(self, task: Any, predicted: float, seconds: float) -> None:
+        """A render predicted at ``predicted`` (``predict_task``) took ``seconds``."""
+        # Renders, not checks or encodes; and against the calibration, not the built-in
+        # guess before it (several times too long: it would hold the average low).
+        if self.calibrated and getattr(task, "variant", None) is not None:
+            self.pace.observe(predicted / (SAFETY * self.pace.factor()), seconds)
 
     def _slowest(self) -> Coefficients:
         """What a label with no timing of its own is priced by: the slowest calibrated

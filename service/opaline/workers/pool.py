@@ -191,6 +191,7 @@ class WorkerPool:
             elif self.cache is not None:
                 self.cache.put(job.key, reply.data)
             self.cost.warmed(job.task)
+            self.cost.observe(job.task, job.predicted, reply.seconds)
             if self.on_rendered is not None:
                 self.on_rendered(job.label, reply.seconds)
             self._settle(job, result=reply.data)
