@@ -135,10 +135,10 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_coat_total": float(per_pixel if brute else samples.passes * samples.factor ** 2),
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
-        # The bands' filtered mean at the cell each wavelength's samples stand for.
-        "u_env_band_mean": band_mean(material.mu_f, material.alpha, material.beta,
-                                     cell_side(job.samples)),
     }
+    if splits_lobe(job):  # the bands' filtered mean at the cell a wavelength's samples span
+        values["u_env_band_mean"] = band_mean(material.mu_f, material.alpha, material.beta,
+                                              cell_side(job.samples))
     if orders_read(job, brute):
         values.update(grating_uniforms())
     if len(environment.light_directions):
