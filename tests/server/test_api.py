@@ -315,6 +315,16 @@ def test_many_unknown_query_fields_get_a_short_answer(client):
     assert [entry["field"] for entry in body["fields"]] == [f"x{i}" for i in range(5)]
 
 
+@pytest.mark.parametrize("path", ["/v1/render", "/v1/turntables", "/v1/export/glb"])
+def test_a_post_refuses_fields_in_its_query_string(client, path):
+    """A POST reads its fields from the body: POST /v1/render?mu_f=2000 with a valid body
+    was a 200 that silently did not use mu_f (a review found it). Now a 422 naming it."""
+    response = client.post(f"{path}?mu_f=2000&width=64", json={"preset": "sphere"})
+    assert response.status_code == 422, response.text
+    line = response.json()["detail"][0]
+    assert "mu_f, width" in line and "JSON body" in line
+
+
 def test_unknown_body_field_is_422(client):
     """An unknown JSON field is refused, naming it."""
     response = client.post("/v1/render", json={"preset": "sphere", "colour": "red"})

@@ -13,7 +13,7 @@ from opaline.model.request import content_key
 from opaline.pipeline.prepare import prepare
 from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES
-from opaline.server.queries import RenderQuery, parse_body
+from opaline.server.queries import RenderQuery, parse_body, refuse_query
 from opaline.server.render_routes import BODY, RENDER_RESPONSES
 from opaline.workers.export_task import GlbTask, GlslTask
 
@@ -38,6 +38,7 @@ async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Requ
              responses={**ERROR_RESPONSES, 404: RENDER_RESPONSES[404]}, openapi_extra=BODY,
              summary="The mesh with the material as glTF 2.0 binary (.glb)")
 async def export_glb_post(request: Request, svc: ServiceDep) -> Response:
+    refuse_query(request.query_params)
     body = parse_body(await request.body(), RenderRequest)
     prepared = prepare(body, svc.context)
     preset, job = prepared.preset, prepared.job

@@ -7,6 +7,7 @@ each time; every other field is the request model's own.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from functools import cache
 from types import NoneType, UnionType
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin
@@ -76,6 +77,22 @@ class Malformed(PublicError, ValueError):
     """A body that is not a JSON document: not UTF-8, not JSON, or nested too deep (400)."""
 
     status, reason = 400, "malformed"
+
+
+class QueryOnPost(PublicError, ValueError):
+    """A POST with a query string: its fields are read from the body only, and a field
+    sent in the query (``POST /v1/render?mu_f=2000``) was silently not used (422)."""
+
+    status, reason = 422, "invalid"
+
+
+def refuse_query(query: Mapping[str, str]) -> None:
+    """``QueryOnPost`` naming the query's parameters (five at most), if it has any."""
+    names = list(dict.fromkeys(query))
+    if names:
+        shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        raise QueryOnPost(f"query: a POST reads its fields from the JSON body, not the query "
+                          f"string ({shown}): send them in the body")
 
 
 Model = TypeVar("Model", bound=BaseModel)

@@ -30,6 +30,7 @@ from opaline.server.errors import (
     StillRendering,
     UnknownTurntable,
 )
+from opaline.server.queries import refuse_query
 from opaline.server.render_routes import RENDER_RESPONSES
 from opaline.server.statestore import Record
 from opaline.server.turntable_jobs import StoredFailure, Turntables, new_job
@@ -83,6 +84,7 @@ BODY = {"requestBody": {"required": True, "content": {
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
 async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep,
                          shared: LanesDep) -> TurntableStatus:
+    refuse_query(request.query_params)
     raw = await request.body()
     planned = plan(svc, raw)
     body, _, key = planned
