@@ -107,9 +107,8 @@ def annulus(inner_radius: float, outer_radius: float, segments: int = 256, rings
     normals = np.stack([zeros, np.ones_like(x), zeros], 1)
     tangents = np.stack([-z, zeros, x], 1) / rr[:, None]
     uvs = np.stack([(x / outer + 1.0) * 0.5, (z / outer + 1.0) * 0.5], 1)
-    indices = [triangle for k in range(len(plan) - 1)
-               for triangle in zip_rings(int(starts[k]), int(counts[k]), int(starts[k + 1]),
-                                         int(counts[k + 1]))]
+    indices = np.concatenate([zip_rings(int(starts[k]), int(counts[k]), int(starts[k + 1]),
+                                        int(counts[k + 1])) for k in range(len(plan) - 1)])
     return make_mesh(positions, normals, tangents, uvs, indices)
 
 

@@ -46,18 +46,20 @@ def ring_plan(inner: float, outer: float, segments: int, rings: int) -> list[tup
     return low + [(float(r), counts[-1]) for r in between] + high[::-1]
 
 
-def zip_rings(first: int, count: int, second: int, next_count: int) -> list[tuple[int, int, int]]:
-    """Triangles between a ring of ``count`` vertices from index ``first`` and the next
-    ring out (``next_count`` from ``second``), both starting at angle 0 and running
-    counter-clockwise seen from +y: walk both by angle, always advancing the one whose
-    next vertex comes first, so every triangle spans one edge of one ring."""
-    triangles = []
-    i = j = 0
-    while i < count or j < next_count:
-        if j == next_count or (i < count and (i + 1) * next_count <= (j + 1) * count):
-            triangles.append((first + i, first + (i + 1) % count, second + j % next_count))
-            i += 1
-        else:
-            triangles.append((first + i % count, second + (j + 1) % next_count, second + j))
-            j += 1
+def zip_rings(first: int, count: int, second: int, next_count: int) -> np.ndarray:
+    """Triangles (k, 3) between a ring of ``count`` vertices from index ``first`` and the
+    next ring out (``next_count`` from ``second``), both starting at angle 0 and running
+    counter-clockwise seen from +y: the two rings' edges taken in the order of the angle
+    they end at (this ring's first on a tie), each with the other ring's vertex reached
+    so far, so every triangle spans one edge of one ring."""
+    ends = np.concatenate([np.arange(1, count + 1) * next_count,
+                           np.arange(1, next_count + 1) * count])  # angles × count·next
+    outer = np.repeat([False, True], [count, next_count])
+    taken = outer[np.lexsort((outer, ends))]
+    i = np.cumsum(~taken) - ~taken  # this ring's edges before each one
+    j = np.cumsum(taken) - taken  # the next ring's
+    a, b = first + i % count, second + j % next_count
+    a_next, b_next = first + (i + 1) % count, second + (j + 1) % next_count
+    triangles: np.ndarray = np.where(taken[:, None], np.stack([a, b_next, b], 1),
+                                     np.stack([a, a_next, b], 1))
     return triangles
