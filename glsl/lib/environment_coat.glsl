@@ -2,16 +2,17 @@
 // filtered importance sampling as the material's own (lib/environment_light.glsl):
 // COAT_SAMPLES directions a pass drawn from the coat's isotropic A-S lobe, each read at
 // the level whose texel spans its share 1/(N·pdf), N = env.coat_total over the pixel's
-// passes. One a pass reads a sharp coat's mirror image at level 0 and a rough one's from
-// a level as wide as its lobe; the brute-force reference draws ENV_SAMPLES at level 0.
-// Contract: included by lib/environment_light.glsl where COAT is defined.
+// passes. A sharp coat, whose one read a pass is already level 0, reads once; a rough one
+// as often as the material's own lobe, pooled over the quad below 48 reads a pixel as
+// the material's are (COAT_QUAD_MEAN; gl/environment_light.py decides both). The
+// brute-force reference draws ENV_SAMPLES at level 0.
+// Contract: included by lib/environment_light.glsl where COAT is defined, after the
+// quad's mean.
 #ifndef ENVIRONMENT_COAT_GLSL
 #define ENVIRONMENT_COAT_GLSL
 #include "lib/coat.glsl"
 
-#ifdef ENV_BRUTE
-#define COAT_SAMPLES ENV_SAMPLES
-#else
+#ifndef COAT_SAMPLES
 #define COAT_SAMPLES 1
 #endif
 
@@ -37,7 +38,12 @@ vec3 environment_coat(Material mat, Environment env, realmat3 frame, vec3 v) {
         vec3 m = env_to_map(env, vec3(frame * real3(ll)));
         sum += env_lookup(env, m, env_lod_of(env, m, pdf_l, env.coat_total)) * weight;
     }
-    return sum / float(COAT_SAMPLES);
+    vec3 own = sum / float(COAT_SAMPLES);
+#ifdef COAT_QUAD_MEAN
+    return mix(own, quad_mean(own), quad_pool_weight(exponent, vec3(frame[2]), v));
+#else
+    return own;
+#endif
 }
 
 #endif

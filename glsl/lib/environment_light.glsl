@@ -176,9 +176,6 @@ vec3 environment_irradiance(Environment env, vec3 n) {
 #ifdef ENV_GRATING_ORDERS
 #include "lib/environment_grating.glsl"
 #endif
-#ifdef COAT
-#include "lib/environment_coat.glsl"
-#endif
 
 // A lobe sample's weight, f(l, v)·(n·l)/pdf(l); hl the sampled half vector and ll the
 // light in the shading frame, i the sample's index in the pass (the bands' share).
@@ -201,7 +198,7 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 #endif
 }
 
-#ifdef ENV_QUAD_MEAN
+#if defined(ENV_QUAD_MEAN) || defined(COAT_QUAD_MEAN)
 // The mean of a value over the pixel's 2×2 quad, from fine derivatives (each row's and each
 // column's own difference; GL's plain dFdx may be the quad's coarse one). The few map
 // samples of the rotation source and of a film evaluated once a pixel are independent from
@@ -224,16 +221,19 @@ vec3 quad_mean(vec3 value) {
 }
 
 // How much of the quad's mean to take: all of it where the lobe's reflection, at its
-// wider width 2/√min(ex, ey), spans at least two of the mirror direction's steps from
-// pixel to pixel (the pool's blur is then inside the lobe), none where it spans one or
-// less (a mirror: every sample reads one direction, and pooling only blurs; on the
-// mirror sphere it took FLIP from 0.017 to 0.029).
-float quad_pool_weight(Material mat, vec3 n, vec3 v) {
+// wider width 2/√exponent (the lobe's smaller exponent), spans at least two of the mirror
+// direction's steps from pixel to pixel (the pool's blur is then inside the lobe), none
+// where it spans one or less (a mirror: every sample reads one direction, and pooling
+// only blurs; on the mirror sphere it took FLIP from 0.017 to 0.029).
+float quad_pool_weight(float exponent, vec3 n, vec3 v) {
     vec3 r = reflect(-v, n);
     float pixel_step = length(abs(QUAD_DX(r)) + abs(QUAD_DY(r)));
-    float lobe_width = 2.0 * inversesqrt(max(min(mat.ex, mat.ey), 1.0));
+    float lobe_width = 2.0 * inversesqrt(max(exponent, 1.0));
     return clamp(lobe_width / max(pixel_step, 1e-6) - 1.0, 0.0, 1.0);
 }
+#endif
+#ifdef COAT
+#include "lib/environment_coat.glsl"
 #endif
 
 vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v, float film_nm) {
@@ -287,7 +287,7 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
     return radiance_floor(sum + specular_envelope(mat, env, vec3(frame[2]), v));
 #elif defined(ENV_QUAD_MEAN)
     vec3 own = sum / float(ENV_SAMPLES);
-    return mix(own, quad_mean(own), quad_pool_weight(mat, vec3(frame[2]), v));
+    return mix(own, quad_mean(own), quad_pool_weight(min(mat.ex, mat.ey), vec3(frame[2]), v));
 #else
     return sum / float(ENV_SAMPLES);
 #endif

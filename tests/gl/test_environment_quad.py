@@ -1,5 +1,6 @@
-"""The map samples of the rotation source and of a film pooled over each 2×2 quad of pixels
-(ENV_QUAD_MEAN in glsl/lib/environment_light.glsl) against its float64 twin,
+"""The map samples of the rotation source, of a film and of a rough clear coat pooled over
+each 2×2 quad of pixels (ENV_QUAD_MEAN and COAT_QUAD_MEAN in
+glsl/lib/environment_light.glsl and lib/environment_coat.glsl) against its float64 twin,
 ``lobe_sampling.quad_means``. On a lobe far wider than a pixel's step (pooled in full)
 the same render without the pooling, averaged quad by quad, must give the pooled render
 where all four pixels of a quad lie on one triangle (the driver shades a quad once per
@@ -40,24 +41,31 @@ def render(renderer, **fields) -> np.ndarray:
 
 
 def unpooled(monkeypatch) -> None:
-    """The surface program compiled without the quad mean, all else the same."""
+    """The surface program compiled without the quad means (the material's lobe's and a
+    clear coat's), all else the same."""
     defines = environment_light.defines
 
     def without_quad_mean(*args, **kwargs):
-        return {**defines(*args, **kwargs), "ENV_QUAD_MEAN": False}
+        found = defines(*args, **kwargs)
+        return {**found, "ENV_QUAD_MEAN": False,
+                **({"COAT_QUAD_MEAN": False} if "COAT_QUAD_MEAN" in found else {})}
 
     monkeypatch.setattr(environment_light, "defines", without_quad_mean)
 
 
 FILM = {"iridescence": "thin-film", "film_ior": 1.33, "film_thickness_min": 300.0,
         "film_thickness_max": 600.0}
+# A rough clear coat over nothing (ks = kd = 0): the image is the coat's reads alone.
+COAT = {"ks": 0.0, "coat_weight": 1.0, "coat_roughness": 0.8, "coat_ior": 2.0}
 
 
 @pytest.mark.parametrize("fields", [{"quality": "standard"}, {"quality": "draft"},
                                     {"quality": "standard", "wavelengths": 0},
                                     {"quality": "standard", **FILM},
-                                    {"quality": "draft", **FILM}],
-                         ids=["standard", "draft", "rgb", "film-standard", "film-draft"])
+                                    {"quality": "draft", **FILM},
+                                    {"quality": "standard", **COAT}],
+                         ids=["standard", "draft", "rgb", "film-standard", "film-draft",
+                              "coat"])
 def test_quad_mean_pools_each_quads_samples(renderer, monkeypatch, fields):
     pooled = render(renderer, **fields)
     with monkeypatch.context() as patch:

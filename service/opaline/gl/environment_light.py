@@ -19,6 +19,7 @@ from opaline.gl.environment_maps import EnvironmentMap
 from opaline.gl.passes import SamplePlan
 from opaline.gl.uniforms import Uniforms
 from opaline.model import grating, visible
+from opaline.model.coat import exponent_from_roughness, has_coat
 from opaline.model.envelope import band_mean, cell_side
 from opaline.model.environment_light import band_samples, reads_orders, splits_lobe
 from opaline.model.params import Material
@@ -34,6 +35,9 @@ from opaline.model.stack_film import is_stack
 # at every sample 0.017-0.029 at two to three times the time; the three channels 0.106
 # against the spectrum's 0.106 at 6 samples, at half the time.
 FILM_PER_SAMPLE_FROM = 48
+# A lobe sample reads the level whose texel spans its share 1/(N·pdf), less this many
+# levels (env_lod_of in glsl/lib/environment_light.glsl).
+LOD_BIAS = 2.0
 
 
 def orders_read(job: Job, brute: bool = False) -> bool:
@@ -61,6 +65,35 @@ def _per_pass(job: Job, samples: SamplePlan) -> int:
 def grating_reads(job: Job, samples: SamplePlan, brute: bool = False) -> int:
     """A pass's reads along the curve a grating's orders leave by (0: not read so)."""
     return _per_pass(job, samples) if orders_read(job, brute) else 0
+
+
+def coat_reads_per_pass(job: Job, samples: SamplePlan, environment: EnvironmentMap,
+                        brute: bool = False) -> int:
+    """A pass's reads of a clear coat's lobe (glsl/lib/environment_coat.glsl): one where
+    one a pass already reads level 0 at the lobe's peak (a sharp coat: more would read the
+    same texels), else as many as the material's own lobe takes. A rough coat of a high
+    index read once a pass was speckled with the soft boxes (`coated-paint` at
+    coat_roughness 1, coat_ior 3, studio, standard: FLIP 0.095, grain 0.062 against the
+    reference's 0.007; at the pass's four, pooled, 0.057 and 0.021)."""
+    if brute:
+        return samples_per_pass(job, samples, brute=True)
+    passes = samples.passes * samples.factor ** 2
+    exponent = exponent_from_roughness(job.material.coat_roughness)
+    share = 8.0 * math.pi / ((exponent + 1.0) * passes)  # 1/(N·pdf), pdf = (e + 1)/(8π)
+    width, height = environment.texture.size
+    texel = 2.0 * math.pi * math.pi / (width * height)  # at the horizon, the largest
+    sharp = 0.5 * math.log2(share / texel) - LOD_BIAS <= 0.0
+    return 1 if sharp else _per_pass(job, samples)
+
+
+def _coat_defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
+                  brute: bool) -> dict[str, int | bool]:
+    if not has_coat(job.material):
+        return {}
+    reads = coat_reads_per_pass(job, samples, environment, brute)
+    per_pixel = reads * samples.passes * samples.factor ** 2
+    return {"COAT_SAMPLES": reads,
+            "COAT_QUAD_MEAN": not brute and reads > 1 and per_pixel < FILM_PER_SAMPLE_FROM}
 
 
 def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
@@ -91,6 +124,7 @@ def defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
             # pooling left the gratings' error where it was (docs/design.md §4.5).
             "ENV_QUAD_MEAN": shared and (three_lobes or film_per_pixel),
             "LIGHT_COUNT": lights if lights else False,
+            **_coat_defines(job, samples, environment, brute),
             # A lobe sample's h is drawn anew in each pixel, so the pixel filter's screen
             # derivative of the multi-peak phase at it means nothing: the brute-force
             # reference reads the bands unfiltered (the split lobe filters its own).
@@ -130,9 +164,8 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_rotation": rotation,
         "u_env_intensity": intensity,
         "u_env_total": float(per_pixel),
-        # A coat's samples (glsl/lib/environment_coat.glsl): one a pass, or the pass's
-        # lobe samples in the brute force.
-        "u_env_coat_total": float(per_pixel if brute else samples.passes * samples.factor ** 2),
+        "u_env_coat_total": float(coat_reads_per_pass(job, samples, environment, brute)
+                                  * samples.passes * samples.factor ** 2),
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
     }

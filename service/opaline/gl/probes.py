@@ -149,7 +149,7 @@ class Probes:
             raise ValueError("rgb_lobes: only the rotation source's Ashikhmin-Shirley lobes")
         defines = {**material_program.material_defines(material, wavelengths,
                                                        orders_read=grating_reads > 0),
-                   "ENV_SAMPLES": samples, "ENV_BRUTE": brute,
+                   "ENV_SAMPLES": samples, "ENV_BRUTE": brute, "COAT_SAMPLES": samples,
                    # As the renderer decides (gl/environment_light.py), for one case.
                    "ENV_ENVELOPE": (coloured_by_rotation and material.mdf == "multipeak"
                                     and wavelengths > 0 and not brute),
@@ -160,8 +160,8 @@ class Probes:
         values = material_program.material_uniforms(material, wavelengths)
         values.update({"u_mode": LOBE_MODES[mode], "u_env_rotation": rotation,
                        "u_env_intensity": intensity, "u_env_total": float(samples * passes),
-                       # The coat's, one a pass (all of a pass's in the brute force).
-                       "u_env_coat_total": float((samples if brute else 1) * passes),
+                       # The coat's reads: as many a pass as the lobe's.
+                       "u_env_coat_total": float(samples * passes),
                        "u_env_lobe_rotation": environment_light.lobe_rotations(material),
                        "u_env_band_mean": band_mean(material.mu_f, material.alpha,
                                                     material.beta, cell_side(passes))})

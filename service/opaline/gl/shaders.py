@@ -29,7 +29,8 @@ BRANCH = re.compile(r"^\s*#\s*(?:else|elif|endif)\b")
 Defines = Mapping[str, int | bool]
 # Features that ask for an optional GL extension: enabled where the driver has it (a
 # warning where not), and the GLSL tests its macro and falls back.
-EXTENSIONS = {"ENV_QUAD_MEAN": "GL_ARB_derivative_control"}
+EXTENSIONS = {"ENV_QUAD_MEAN": "GL_ARB_derivative_control",
+              "COAT_QUAD_MEAN": "GL_ARB_derivative_control"}
 # A compiled variant: its program file and its defines that are on, sorted (name, value).
 ProgramKey = tuple[str, tuple[tuple[str, int], ...]]
 
@@ -81,8 +82,8 @@ def compose(program: str, stage: str, defines: Defines) -> tuple[str, list[str]]
         raise ShaderError(f"{program} has no feature(s) {sorted(unknown)}")
     precise = bool(defines.get("PRECISE_PHASE"))
     header = ["#version 400 core" if precise else "#version 330 core"]
-    header += [f"#extension {EXTENSIONS[key]} : enable" for key in sorted(EXTENSIONS)
-               if defines.get(key)]
+    header += [f"#extension {name} : enable"
+               for name in sorted({EXTENSIONS[key] for key in EXTENSIONS if defines.get(key)})]
     header.append(f"#define {stage}")
     for key in sorted(defines):
         value = defines[key]
