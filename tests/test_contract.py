@@ -58,6 +58,19 @@ def test_integral_float_is_an_integer_as_json_schema_says(client):
     assert response.status_code == 200, response.text
 
 
+@pytest.mark.parametrize(("path", "body", "name"), [
+    ("/v1/render", b'{"mu_f": 2000, "preset": "sphere", "mu_f": 1}', "mu_f"),
+    ("/v1/render", b'{"width": 32, "width": 32}', "width"),
+    ("/v1/turntables", b'{"frames": 4, "quality": "draft", "quality": "high"}', "quality"),
+    ("/v1/export/glb", b'{"preset": "sphere", "a b": 1, "a b": 2}', '"a b"')])
+def test_a_key_given_twice_in_the_body_is_422_naming_it(client, path, body, name):
+    """{"mu_f": 2000, "mu_f": 1} was a 200 that used the last (pydantic's parser keeps it),
+    though the first is out of range: which one counts is the parser's choice (RFC 8259
+    §4). Now refused, with the key named."""
+    (line,) = error(client.post(path, content=body, headers=JSON), 422, "invalid")
+    assert line.startswith(f"{name}: given more than once"), line
+
+
 @pytest.mark.parametrize(("body", "words"), [
     (b"\xff\xfe{}", "UTF-8"),
     (b"[" * 300 + b"]" * 300, "recursion"),
@@ -125,6 +138,17 @@ def test_options_and_405_name_every_method_of_the_path(client, path, allow):
 def test_unknown_path_is_404_in_the_public_shape(client):
     error(client.get("/v2/nothing"), 404, "not_found")
     error(client.options("/v2/nothing"), 404, "not_found")
+
+
+@pytest.mark.parametrize("path", ["/v1/render/", "/v1/presets/", "/v1/meshes/"])
+def test_a_trailing_slash_is_not_redirected_to_the_clients_host(client, path):
+    """Starlette answered /v1/render/ with a 307 to http://{the request's Host}/v1/render:
+    a forged Host made the service point clients elsewhere (a review found it). Now a 404
+    that names the path to use."""
+    response = client.get(path, headers={"host": "evil.example"}, follow_redirects=False)
+    (line,) = error(response, 404, "not_found")
+    assert "location" not in response.headers
+    assert f"did you mean {path.rstrip('/')} " in line
 
 
 # The document says exactly what is validated

@@ -221,7 +221,7 @@ def create_app(settings: Settings | None = None, renderer_factory: Any = None) -
     metrics.watch_pool(pool.counters, lambda: cache.evictions)
     metrics.watch_connections(CONNECTION_STATS)
     app = FastAPI(title="Opaline", version=__version__, lifespan=lifespan,
-                  docs_url=None, redoc_url=None,
+                  docs_url=None, redoc_url=None, redirect_slashes=False,
                   responses={k: ERROR_RESPONSES[k] for k in (403, 404, 422, 429, 500)},
                   description="Headless previews of iridescent materials "
                               "(Kang, Lee, Cho 2014, multi-peak anisotropic microfacet model).")

@@ -10,6 +10,9 @@ A query string may repeat a name; pydantic keeps the last value, so
 scalar parameter is now a 422 naming it; only the tuple fields of the query models
 (``albedo=R&albedo=G&albedo=B``, ``tangent_axis`` ...) may repeat, read from the models
 so that a new tuple field repeats without a change here.
+
+A path with a trailing slash that only has a route without it is a 404 naming that
+path, where Starlette redirected to it.
 """
 
 from __future__ import annotations
@@ -46,6 +49,17 @@ def allowed_methods(app: Starlette, scope: Scope) -> set[str]:
     return methods | {"OPTIONS"} if methods else methods
 
 
+def without_slash(app: Starlette, scope: Scope) -> str | None:
+    """The path less its trailing slash where only that has a route. The app does not
+    redirect there (redirect_slashes is off): Starlette's redirect wrote the request's
+    Host header into its Location, so a forged Host sent clients elsewhere."""
+    path = scope["path"]
+    if len(path) < 2 or not path.endswith("/") or allowed_methods(app, scope):
+        return None
+    bare = path.rstrip("/")
+    return bare if allowed_methods(app, {**scope, "path": bare}) else None
+
+
 def repeated(query_string: bytes) -> list[str]:
     """One line per scalar parameter given more than once."""
     counts = Counter(name for name, _ in parse_qsl(query_string.decode("latin-1"),
@@ -80,6 +94,12 @@ class Methods:
                 await problem(405, "method_not_allowed", f"{method} is not allowed here",
                               headers={"Allow": ", ".join(sorted(allowed))})(scope, receive, send)
                 return
+        bare = without_slash(self.routes_of, scope)
+        if bare:
+            self.on_reject("not_found")
+            await problem(404, "not_found", f"Not Found: did you mean {bare} (without the "
+                          "trailing slash)?")(scope, receive, send)
+            return
         lines = repeated(scope.get("query_string", b""))
         if lines:
             self.on_reject("invalid")

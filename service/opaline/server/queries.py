@@ -7,6 +7,7 @@ each time; every other field is the request model's own.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from functools import cache
 from types import NoneType, UnionType
@@ -95,12 +96,31 @@ def refuse_query(query: Mapping[str, str]) -> None:
                           f"string ({shown}): send them in the body")
 
 
+class DuplicateKey(PublicError, ValueError):
+    """A body naming a key twice in one object: JSON leaves which one counts to the
+    parser (RFC 8259 §4), and the last silently won (422)."""
+
+    status, reason = 422, "invalid"
+
+
+def _refuse_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    found: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in found:
+            name = key if key.isidentifier() else json.dumps(key)[:80]
+            raise DuplicateKey(f"{name}: given more than once in one object of the JSON body "
+                               "(which one counts is the parser's choice): give it once")
+        found[key] = value
+    return found
+
+
 Model = TypeVar("Model", bound=BaseModel)
 
 
 def parse_body(raw: bytes, model: type[Model]) -> Model:
     """A JSON body as ``model``, strictly: numbers must be JSON numbers and booleans JSON
-    booleans, as the OpenAPI document says ({"mu_f": "6"} and {"mu_f": false} are refused);
+    booleans, as the OpenAPI document says ({"mu_f": "6"} and {"mu_f": false} are refused),
+    and a key given twice in one object is refused (``DuplicateKey``);
     an integer field takes an integral number written as a float (178.0), as JSON Schema's
     "integer" does. pydantic's parser bounds the nesting depth; a parse failure is
     ``Malformed``."""
@@ -114,6 +134,9 @@ def parse_body(raw: bytes, model: type[Model]) -> Model:
         data = from_json(raw)
     except ValueError as exc:
         raise Malformed(f"body: not valid JSON ({exc})") from None
+    # Parsed again only to see every key (pydantic's parser keeps the last of a repeated
+    # one); its nesting is already bounded by the parse above.
+    json.loads(raw, object_pairs_hook=_refuse_duplicates)
     if isinstance(data, dict):
         for name in integer_fields(model) & data.keys():
             value = data[name]
