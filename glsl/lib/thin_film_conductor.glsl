@@ -45,11 +45,24 @@ float film_bare_conductor(float cos1, vec2 nk) {
 
 #if WAVELENGTHS > 0
 // u_substrate_nk: n + ik at each wavelength.
-// One polarisation: a real, b complex, e = e^{iφ}.
-float film_airy_complex(float a, vec2 b, vec2 e) {
-    float b2 = dot(b, b);
-    float re = b.x * e.x - b.y * e.y;  // Re(b·e^{iφ})
-    return max(a * a + b2 + 2.0 * a * re, 0.0) / max(1.0 + a * a * b2 + 2.0 * a * re, 1e-30);
+// A wavelength stands for a bin of (780 - 380)/WAVELENGTHS nm (model/spectrum.py), across
+// which a micron-thick film's phase turns a cycle or more: each reads R averaged over its
+// bin's phases (float64 twin: opaline/model/airy_band.py, which derives this).
+#define FILM_BIN_NM (400.0 / float(WAVELENGTHS))
+
+// One polarisation (a real, b complex) averaged about e = e^{iφ} by a Poisson kernel of
+// radius rho (1: Airy's own value, 0: the incoherent sum): with q = -ab, β = (1 - a²)·b,
+//   R = C0 + 2·Re(K·w/(1 - q·w)),  w = rho·e,
+//   C0 = a² + |β|²/(1 - |q|²),  K = a·β + |β|²·q/(1 - |q|²).
+float film_airy_band(float a, vec2 b, vec2 e, float rho) {
+    vec2 beta = (1.0 - a * a) * b;
+    vec2 q = -a * b;
+    float beta_sq = dot(beta, beta);
+    float inverse = 1.0 / max(1.0 - dot(q, q), 1e-30);
+    vec2 k = a * beta + beta_sq * inverse * q;
+    vec2 w = rho * e;
+    vec2 term = c_div(c_mul(k, w), vec2(1.0, 0.0) - c_mul(q, w));
+    return max(a * a + beta_sq * inverse + 2.0 * term.x, 0.0);
 }
 
 // The base without its film: the bare metal, integrated as the film is.
@@ -74,10 +87,16 @@ vec3 film_rgb(Film film, float cos1, float d) {
     vec3 sum = vec3(0.0);
     for (int i = 0; i < WAVELENGTHS; ++i) {
         vec4 r23 = film_conductor_r23(film.ior, cos1, cos2, u_substrate_nk[i]);
-        // φ in cycles, reduced before the trigonometry, as the dielectric path.
-        float phase = TWO_PI * fract(opd / u_wavelength_nm[i]);
+        // φ in cycles, reduced before the trigonometry, as the dielectric path. Its spread
+        // over the bin, Δφ = φ·Δλ/λ: the terms the samples resolve (m·Δφ < π) are kept,
+        // the first is removed where it would alias (model/airy_band.py).
+        float cycles = opd / u_wavelength_nm[i];
+        float phase = TWO_PI * fract(cycles);
+        float spread = 2.0 * cycles * FILM_BIN_NM / u_wavelength_nm[i];  // Δφ/π
+        float rho = exp(-(spread * spread) * (spread * spread));
         vec2 e = vec2(cos(phase), sin(phase));
-        float r = 0.5 * (film_airy_complex(r12.x, r23.xy, e) + film_airy_complex(r12.y, r23.zw, e));
+        float r = 0.5 * (film_airy_band(r12.x, r23.xy, e, rho)
+                         + film_airy_band(r12.y, r23.zw, e, rho));
         sum += u_spectral_weight[i] * r;
     }
     return radiance_floor(sum);

@@ -28,9 +28,10 @@ import numpy as np
 import numpy.typing as npt
 
 from opaline.model import visible
+from opaline.model.airy_band import airy_band, bin_damping
 from opaline.model.color_space import radiance_floor
 from opaline.model.microfacet import FloatArray, Values
-from opaline.model.spectrum import rgb_weights, sample_wavelengths
+from opaline.model.spectrum import RANGE_NM, rgb_weights, sample_wavelengths
 
 # Per polarisation (s, p): one Fresnel amplitude coefficient each.
 # (r23 is complex under a conductor.)
@@ -101,12 +102,18 @@ def airy(a: FloatArray, b: npt.NDArray[Any], phase: FloatArray) -> FloatArray:
 
 
 def film_reflectance(
-    cos1: npt.ArrayLike, lam_nm: Values, d_nm: Values, n_film: float, n_sub: Substrate
+    cos1: npt.ArrayLike, lam_nm: Values, d_nm: Values, n_film: float, n_sub: Substrate,
+    bin_nm: float = 0.0,
 ) -> FloatArray:
-    """Airy reflectance averaged over s and p at wavelength ``lam_nm`` (broadcasts)."""
+    """Airy reflectance averaged over s and p at wavelength ``lam_nm`` (broadcasts); over a
+    conductor with ``bin_nm`` > 0, averaged across a bin that wide (model/airy_band.py)."""
     cos2, (r12s, r12p), (r23s, r23p), tir = interfaces(cos1, n_film, n_sub)
     phase = 4.0 * np.pi * n_film * d_nm * cos2 / lam_nm
-    r = 0.5 * (airy(r12s, r23s, phase) + airy(r12p, r23p, phase))
+    if bin_nm > 0.0 and np.iscomplexobj(r23s):
+        rho = bin_damping(phase, lam_nm, bin_nm)
+        r = 0.5 * (airy_band(r12s, r23s, phase, rho) + airy_band(r12p, r23p, phase, rho))
+    else:
+        r = 0.5 * (airy(r12s, r23s, phase) + airy(r12p, r23p, phase))
     return np.where(tir, 1.0, r)
 
 
@@ -114,11 +121,12 @@ def film_rgb_spectral(
     cos1: npt.ArrayLike, d_nm: npt.ArrayLike, n_film: float, n_sub: Substrate, wavelengths: int
 ) -> FloatArray:
     """Σ_i w_i·R(λ_i): ``wavelengths`` bins over 380-780 nm, CIE 1931 to linear sRGB (a
-    conductor's ``n_sub`` has one n + ik per bin)."""
+    conductor's ``n_sub`` has one n + ik per bin, and its R is averaged across the bin)."""
     cos1 = np.asarray(cos1, dtype=np.float64)
     lam = sample_wavelengths(wavelengths)
     weights = rgb_weights(wavelengths)
-    r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub)
+    r = film_reflectance(cos1[..., None], lam, np.asarray(d_nm)[..., None], n_film, n_sub,
+                         (RANGE_NM[1] - RANGE_NM[0]) / wavelengths)  # each bin's width
     rgb: FloatArray = radiance_floor(r @ weights)  # a channel below 0: the display's map
     return rgb
 
