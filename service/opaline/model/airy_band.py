@@ -55,5 +55,9 @@ def airy_band(a: FloatArray, b: npt.NDArray[Any], phase: FloatArray,
     c0 = a * a + beta_sq * inverse
     k = a * beta + beta_sq * inverse * q
     w = np.asarray(rho) * np.exp(1j * np.asarray(phase))
-    value: FloatArray = np.maximum(c0 + 2.0 * np.real(k * w / (1.0 - q * w)), 0.0)
+    # 1 − q·w vanishes only exactly at grazing (a = −1, |b| = 1), where the caller takes 1:
+    # floored as the shader's complex division floors it, so no 0/0 is formed.
+    den = 1.0 - q * w
+    term = k * w * np.conj(den) / np.maximum(np.abs(den) ** 2, 1e-30)
+    value: FloatArray = np.maximum(c0 + 2.0 * np.real(term), 0.0)
     return value
