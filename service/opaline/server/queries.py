@@ -18,6 +18,7 @@ from pydantic_core import from_json, to_json
 
 from opaline.errors import PublicError
 from opaline.model.material import Unit
+from opaline.model.messages import UNKNOWN_NAMED
 from opaline.model.params import (
     MaterialFields,
     Pixels,
@@ -88,10 +89,12 @@ class QueryOnPost(PublicError, ValueError):
 
 
 def refuse_query(query: Mapping[str, str]) -> None:
-    """``QueryOnPost`` naming the query's parameters (five at most), if it has any."""
+    """``QueryOnPost`` naming the query's parameters (as many as an unknown field's
+    message names, the rest counted), if it has any."""
     names = list(dict.fromkeys(query))
     if names:
-        shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+        more = len(names) - UNKNOWN_NAMED
+        shown = ", ".join(names[:UNKNOWN_NAMED]) + (f" and {more} more" if more > 0 else "")
         raise QueryOnPost(f"query: a POST reads its fields from the JSON body, not the query "
                           f"string ({shown}): send them in the body")
 
