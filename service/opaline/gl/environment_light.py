@@ -58,8 +58,7 @@ def samples_per_pass(job: Job, samples: SamplePlan, brute: bool = False) -> int:
 
 
 def _per_pass(job: Job, samples: SamplePlan) -> int:
-    per_pass_pixels = samples.passes * samples.factor * samples.factor
-    return max(1, -(-job.environment_sample_count // per_pass_pixels))
+    return max(1, -(-job.environment_sample_count // samples.pass_pixels))
 
 
 def grating_reads(job: Job, samples: SamplePlan, brute: bool = False) -> int:
@@ -77,9 +76,9 @@ def coat_reads_per_pass(job: Job, samples: SamplePlan, environment: EnvironmentM
     reference's 0.007; at the pass's four, pooled, 0.057 and 0.021)."""
     if brute:
         return samples_per_pass(job, samples, brute=True)
-    passes = samples.passes * samples.factor ** 2
     exponent = exponent_from_roughness(job.material.coat_roughness)
-    share = 8.0 * math.pi / ((exponent + 1.0) * passes)  # 1/(N·pdf), pdf = (e + 1)/(8π)
+    # 1/(N·pdf) for one read a pass, pdf = (e + 1)/(8π) at the peak
+    share = 8.0 * math.pi / ((exponent + 1.0) * samples.pass_pixels)
     width, height = environment.texture.size
     texel = 2.0 * math.pi * math.pi / (width * height)  # at the horizon, the largest
     sharp = 0.5 * math.log2(share / texel) - LOD_BIAS <= 0.0
@@ -91,7 +90,7 @@ def _coat_defines(job: Job, samples: SamplePlan, environment: EnvironmentMap,
     if not has_coat(job.material):
         return {}
     reads = coat_reads_per_pass(job, samples, environment, brute)
-    per_pixel = reads * samples.passes * samples.factor ** 2
+    per_pixel = reads * samples.pass_pixels
     return {"COAT_SAMPLES": reads,
             "COAT_QUAD_MEAN": not brute and reads > 1 and per_pixel < FILM_PER_SAMPLE_FROM}
 
@@ -155,7 +154,7 @@ def lobe_rotations(material: Material) -> list[tuple[float, float]]:
 
 def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
              brute: bool = False) -> Uniforms:
-    per_pixel = samples_per_pass(job, samples, brute) * samples.passes * samples.factor ** 2
+    per_pixel = samples_per_pass(job, samples, brute) * samples.pass_pixels
     material = job.material
     rotation = math.radians(job.environment_rotation or 0.0)
     intensity = 1.0 if job.environment_intensity is None else job.environment_intensity
@@ -165,7 +164,7 @@ def uniforms(job: Job, samples: SamplePlan, environment: EnvironmentMap,
         "u_env_intensity": intensity,
         "u_env_total": float(per_pixel),
         "u_env_coat_total": float(coat_reads_per_pass(job, samples, environment, brute)
-                                  * samples.passes * samples.factor ** 2),
+                                  * samples.pass_pixels),
         "u_env_pass": 0,
         "u_env_lobe_rotation": lobe_rotations(material),
     }

@@ -36,6 +36,12 @@ class SamplePlan:
     def passes(self) -> int:
         return len(self.offsets)
 
+    @property
+    def pass_pixels(self) -> int:
+        """The sample-target pixels one image pixel is drawn in over all passes: each
+        reads the environment's per-pass samples once."""
+        return self.passes * self.factor * self.factor
+
     def target_size(self, size: tuple[int, int]) -> tuple[int, int]:
         return size[0] * self.factor, size[1] * self.factor
 
