@@ -8,8 +8,9 @@ breaking ties. Loading runs in the render worker processes only: trimesh's
 parsers are the riskiest code that ever sees a request, and a worker that
 crashes on one is replaced while the HTTP process answers on.
 
-The mesh keeps its own coordinates (the camera frames its bounds); normals
-are trimesh's area-weighted vertex normals; tangents are ``tangents.tangent_frame``.
+The mesh keeps its own coordinates (the camera frames its bounds); normals are
+area-weighted and smooth across split vertices (``normals.vertex_normals``); tangents
+are ``tangents.tangent_frame``.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from opaline.scene import meshlimits
 from opaline.scene import tangents as tangent_fields
 from opaline.scene.gltf_film import check_film_textures
 from opaline.scene.mesh import Mesh, make_mesh
+from opaline.scene.normals import vertex_normals
 from opaline.scene.parse_memory import parse_ceiling, parse_headroom
 
 if TYPE_CHECKING:
@@ -153,7 +155,7 @@ def build_mesh(data: bytes, fmt: str, field: str = "auto",
                                     positions[faces[:, 2]] - positions[faces[:, 0]]), axis=1)
     if not np.any(areas > 0.0):
         raise MeshError("every triangle has zero area")
-    normals = _vertex_normals(positions, faces, areas)
+    normals = vertex_normals(positions, faces)
     uvs = _uvs(loaded, len(positions))
     try:
         tangents, used_field = tangent_fields.tangent_frame(positions, normals, uvs, faces,
@@ -167,21 +169,6 @@ def build_mesh(data: bytes, fmt: str, field: str = "auto",
                "uvs": uvs is not None, "tangents": used_field,
                "bounds": [lo.tolist(), hi.tolist()]}
     return mesh, summary
-
-
-def _vertex_normals(positions: np.ndarray, faces: np.ndarray, areas: np.ndarray) -> np.ndarray:
-    """Area-weighted face normals summed per vertex (the cross product's length is 2×area)."""
-    face_n = np.cross(positions[faces[:, 1]] - positions[faces[:, 0]],
-                      positions[faces[:, 2]] - positions[faces[:, 0]])
-    summed = np.zeros_like(positions)
-    for corner in range(3):
-        np.add.at(summed, faces[:, corner], face_n)
-    length = np.linalg.norm(summed, axis=1)
-    bad = length < 1e-30  # unused vertices and cancelling fans: any unit vector will do
-    summed[bad] = (0.0, 1.0, 0.0)
-    length[bad] = 1.0
-    unit: np.ndarray = summed / length[:, None]
-    return unit
 
 
 # (path, size, mtime, field, axis, max_triangles) -> parse_mesh's answer
