@@ -7,7 +7,7 @@ import argparse
 import difflib
 import sys
 from pathlib import Path
-from typing import Any, get_args
+from typing import Any, get_args, get_origin
 
 from pydantic import ValidationError
 
@@ -24,7 +24,17 @@ from opaline.output.encode import EXTENSIONS
 from opaline.output.files import write_atomic
 from opaline.settings import BACKENDS
 
-TUPLE_FIELDS = {"albedo", "tangent_axis"}
+
+def _tuple_fields() -> frozenset[str]:
+    """The request's fields that take a tuple (albedo, metal_f0, ...): their --set value
+    is split at commas."""
+    def takes_tuple(annotation: Any) -> bool:
+        return get_origin(annotation) is tuple or any(takes_tuple(a) for a in get_args(annotation))
+    return frozenset(name for name, field in RenderRequest.model_fields.items()
+                     if takes_tuple(field.annotation))
+
+
+TUPLE_FIELDS = _tuple_fields()
 MATERIAL_SUFFIXES = (".toml", ".json")
 # What an extension may hold: the first is what the extension alone means.
 FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",), ".webp": ("webp", "webp-lossless"),
@@ -71,7 +81,10 @@ def parse_sets(pairs: list[str]) -> dict[str, Any]:
         name, sep, value = pair.partition("=")
         if not sep or not name:
             raise CliError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set mu_f=8.5")
-        values[name.strip()] = value.split(",") if name.strip() in TUPLE_FIELDS else value
+        name = name.strip()
+        if name in values:  # as a query parameter or a JSON key given twice is refused
+            raise CliError(f"--set {name}: given more than once; give each parameter once")
+        values[name] = value.split(",") if name in TUPLE_FIELDS else value
     return values
 
 

@@ -27,6 +27,7 @@ from opaline.model.meshes import MeshFileMissing
 from opaline.model.params import RenderRequest
 from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
+from opaline.pipeline.limits import LimitError
 from opaline.resources import PRESETS_ENV, presets_dir
 from opaline.scene.environments import EnvironmentMapError
 from opaline.scene.meshfile import MeshError
@@ -34,7 +35,7 @@ from opaline.settings import SettingsError
 
 log = logging.getLogger("opaline.cli")
 USAGE_ERRORS = (PresetError, UnknownPreset, CostError, MaterialError, MeshError,
-                EnvironmentMapError, MeshFileMissing, SettingsError)
+                EnvironmentMapError, MeshFileMissing, SettingsError, LimitError)
 # Commands that read presets take --presets-dir; `mdf --help` must not talk about presets.
 USES_PRESETS = ("render", "presets", "batch", "gallery", "serve", "turntable", "export",
                 "import")

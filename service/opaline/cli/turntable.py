@@ -8,6 +8,8 @@ import logging
 import time
 from typing import TYPE_CHECKING, get_args
 
+from pydantic import ValidationError
+
 from opaline.cli.args import (
     CliError,
     add_common,
@@ -16,7 +18,7 @@ from opaline.cli.args import (
     source_fields,
     write_output,
 )
-from opaline.model.params import Quality
+from opaline.model.params import Quality, describe_errors
 
 if TYPE_CHECKING:
     from opaline.model.turntable import AnimationFormat
@@ -38,8 +40,8 @@ def cmd_turntable(args: argparse.Namespace) -> None:
     try:
         request = TurntableRequest(**base.model_dump(exclude_none=True), frames=args.frames,
                                    fps=args.fps, animation=fmt)
-    except ValueError as exc:
-        raise CliError(str(exc).splitlines()[0]) from None
+    except ValidationError as exc:  # frames, fps: named with their range, as the API does
+        raise CliError("; ".join(describe_errors(exc, TurntableRequest))) from None
     started = time.perf_counter()
 
     def progress(done: int, total: int) -> None:

@@ -1,0 +1,58 @@
+"""The CLI's errors are one line that names the field and its range, as the API's are,
+and ``--set`` takes every field the API takes, once."""
+
+from __future__ import annotations
+
+import pytest
+
+from opaline.cli import main as cli
+from opaline.cli.args import parse_sets
+from opaline.model.params import RenderRequest
+
+TINY = ["--size", "16x16", "--quality", "draft"]
+
+
+def one_line_error(capsys, *argv: str) -> str:
+    code = cli.main(list(argv))
+    _, err = capsys.readouterr()
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err  # before: a traceback, or pydantic's first line only
+    return lines[0]
+
+
+@pytest.mark.gl
+@pytest.mark.usefixtures("shared_renderer")
+@pytest.mark.parametrize("command", ["render", "turntable"])
+def test_a_limit_is_one_line(capsys, tmp_path, command):
+    out = tmp_path / ("t.jpg" if command == "render" else "t.webp")
+    argv = [command, "cd-rom", *TINY, "--set", "transparent=true", "-o", str(out)]
+    if command == "turntable":
+        argv += ["--frames", "2", "--set", "format=jpeg"]
+    line = one_line_error(capsys, *argv)
+    assert "format=jpeg has no alpha channel" in line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(("flag", "value", "words"), [
+    ("--frames", "1", "frames=1 is out of range: allowed [2 … 360]"),
+    ("--frames", "400", "frames=400 is out of range: allowed [2 … 360]"),
+    ("--fps", "0", "fps=0 is out of range: allowed [1 … 60]"),
+])
+def test_turntable_ranges_name_the_field(capsys, tmp_path, flag, value, words):
+    line = one_line_error(capsys, "turntable", "cd-rom", flag, value,
+                          "-o", str(tmp_path / "t.gif"))
+    assert words in line
+
+
+def test_a_parameter_set_twice_is_refused(capsys, tmp_path):
+    line = one_line_error(capsys, "render", "cd-rom", "--set", "mu_f=6", "--set", "mu_f=7",
+                          "-o", str(tmp_path / "x.png"))
+    assert "--set mu_f: given more than once" in line
+
+
+@pytest.mark.parametrize("name", ["albedo", "metal_f0", "metal_edge_tint", "tangent_axis"])
+def test_every_tuple_field_takes_commas(name):
+    fields = parse_sets([f"{name}=1,0,0"])
+    request = RenderRequest(preset="tempered-steel", metal="artist", **fields)
+    assert getattr(request, name) == (1.0, 0.0, 0.0)  # before: metal_f0 "a valid tuple"
