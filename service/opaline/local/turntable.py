@@ -56,7 +56,7 @@ def turntable_bytes(local: LocalRenderer, request: TurntableRequest,
         if pixels is None:
             assert frame.display is not None  # a frame without 8-bit pixels has display values
             pixels = quantise(frame.display, 8)
-        frames.append(np.ascontiguousarray(pixels[..., :3]))
+        frames.append(np.ascontiguousarray(pixels))  # RGBA where transparent (WebP keeps it)
         if progress is not None:
             progress(index, len(jobs))
     return encode(frames, request.animation, request.fps)

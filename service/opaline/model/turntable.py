@@ -12,7 +12,7 @@ import math
 from dataclasses import replace
 from typing import Annotated, Literal
 
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
 from opaline.model.meshes import MESH_VIEW, is_mesh
 from opaline.model.params import RenderRequest
@@ -29,7 +29,18 @@ class TurntableRequest(RenderRequest):
         36, description="Frames in one turn, 2 … 360.")
     fps: Annotated[int, Field(ge=1, le=60)] = Field(24, description="Frames per second, 1 … 60.")
     animation: AnimationFormat = Field(
-        "webp", description="'webp' (animated WebP), 'gif' or 'mp4' (H.264).")
+        "webp", description="'webp' (animated WebP, the one with an alpha channel: "
+                            "transparent=true), 'gif' or 'mp4' (H.264).")
+
+    @field_validator("animation")
+    @classmethod
+    def _alpha_only_in_webp(cls, animation: str, info: ValidationInfo) -> str:
+        # GIF's one transparent palette entry and H.264's lack of alpha would draw a
+        # transparent backdrop black, so such a turntable is refused, not degraded.
+        if info.data.get("transparent") and animation != "webp":
+            raise ValueError("a GIF or an MP4 has no alpha channel: transparent=true needs "
+                             "animation=webp")
+        return animation
 
 
     def still(self) -> RenderRequest:

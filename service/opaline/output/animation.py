@@ -1,4 +1,4 @@
-"""Turntable encoders: frames (H, W, 3 uint8 sRGB) to animated WebP, GIF or MP4, and back.
+"""Turntable encoders: frames (H, W, 3 or 4 uint8 sRGB) to animated WebP, GIF or MP4, and back.
 
 WebP and GIF through Pillow; MP4 (H.264, yuv420p, the format every browser
 and editor plays) through imageio-ffmpeg, which ships its own ffmpeg binary
@@ -38,7 +38,9 @@ def encode(frames: list[np.ndarray], fmt: str, fps: int) -> bytes:
         raise ValueError("an animation needs at least one frame")
     if fmt == "mp4":
         return _mp4(frames, fps)
-    images = [Image.fromarray(np.ascontiguousarray(f[..., :3])) for f in frames]
+    # WebP keeps a transparent backdrop's alpha; the request refuses it for the others.
+    channels = 4 if fmt == "webp" and frames[0].shape[-1] == 4 else 3
+    images = [Image.fromarray(np.ascontiguousarray(f[..., :channels])) for f in frames]
     out = io.BytesIO()
     duration = max(1, round(1000 / fps))
     if fmt == "gif":
@@ -47,8 +49,12 @@ def encode(frames: list[np.ndarray], fmt: str, fps: int) -> bytes:
         images[0].save(out, format="GIF", save_all=True, append_images=images[1:],
                        duration=duration, loop=0, disposal=1, optimize=False)
     else:
+        # With alpha, every frame a key frame: libwebp's lossy sub-frames, cropped to
+        # where a frame changed, left the canvas without its alpha flag, and decoders
+        # drew the transparent backdrop opaque black.
+        keys = {"kmax": 1} if channels == 4 else {}
         images[0].save(out, format="WEBP", save_all=True, append_images=images[1:],
-                       duration=duration, loop=0, quality=85, method=4)
+                       duration=duration, loop=0, quality=85, method=4, **keys)
     return out.getvalue()
 
 

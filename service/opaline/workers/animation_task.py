@@ -27,7 +27,7 @@ class AnimationTask:
     label: str = ENCODE_LABEL
 
     def run(self, renderer: Any, should_stop: StopCheck) -> bytes:
-        frames = [np.asarray(Image.open(io.BytesIO(png)).convert("RGB")) for png in self.frames]
+        frames = [np.asarray(_rgb_or_rgba(Image.open(io.BytesIO(png)))) for png in self.frames]
         return encode(frames, self.fmt, self.fps)
 
     def units(self) -> tuple[str, float, int, float]:
@@ -36,3 +36,8 @@ class AnimationTask:
         # a PNG's size is in its header (IHDR, bytes 16-24)
         width, height = struct.unpack(">II", first[16:24]) if len(first) >= 24 else (0, 0)
         return ENCODE_LABEL, 0.0, 0, encode_cost_s(len(self.frames), width, height, self.fmt)
+
+
+def _rgb_or_rgba(image: Image.Image) -> Image.Image:
+    """A transparent render's frame keeps its alpha (WebP encodes it), any other is RGB."""
+    return image.convert("RGBA" if "A" in image.getbands() else "RGB")
