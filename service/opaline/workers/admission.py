@@ -57,6 +57,7 @@ WARM_VARIANTS = 64  # as many as a worker keeps compiled by default (worker_prog
 # worker's first check, then about 0.14 s/MB for the slowest format (ASCII PLY), and at
 # most its own time limit, after which the worker is killed.
 CHECK_LABEL = "mesh-check"
+MDF_LABEL = "mdf-plot"  # the MDF plot's label (workers/tasks.MdfTask)
 CHECK_TIME_LIMIT_S = 10.0  # 64 MiB, the largest upload, parses in about 8.5 s
 CHECK_BASE_S = 1.0
 CHECK_S_PER_BYTE = 0.15 / (1 << 20)
@@ -214,6 +215,7 @@ def check_cost_s(size_bytes: float) -> float:
 
 
 RENDER_ADVICE = "lower width, height, samples or wavelengths (or choose a lower quality)"
+PLOT_ADVICE = "lower size or wavelengths"
 CHECK_ADVICE = ("send a smaller file (fewer triangles; GLB or binary PLY read fastest), or "
                 "ask the operator for a longer OPALINE_DEADLINE_S")
 
@@ -228,8 +230,9 @@ def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequ
     if not workers:
         return Unavailable("no render worker has a GL context (the server log says why)")
     if predicted > deadline_s:
-        what, advice = (("checking this mesh file", CHECK_ADVICE) if label == CHECK_LABEL
-                        else ("this request", RENDER_ADVICE))
+        what, advice = {CHECK_LABEL: ("checking this mesh file", CHECK_ADVICE),
+                        MDF_LABEL: ("this plot", PLOT_ADVICE)}.get(
+                            label, ("this request", RENDER_ADVICE))
         return TooSlow(f"{what} is predicted to take {predicted:.1f} s, over the "
                        f"{deadline_s:g} s limit: {advice}")
     backlog = (sum(running) + sum(queued)) / workers

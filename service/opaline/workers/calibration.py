@@ -9,14 +9,16 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from opaline.model.params import RenderRequest
+from opaline.model.params import Material, RenderRequest
 from opaline.model.presets import Preset, all_presets
 from opaline.pipeline.prepare import prepare
 from opaline.scene.environments import MESH_ENVIRONMENT
+from opaline.workers.admission import MDF_LABEL
 from opaline.workers.tasks import (
     PRIVATE,
     UNDER_ENVIRONMENT,
     ImageTask,
+    MdfTask,
     StopCheck,
     lit_by_own_lights,
 )
@@ -24,6 +26,7 @@ from opaline.workers.tasks import (
 CALIBRATION_SIZE = 192
 CALIBRATION_SAMPLES = 2
 CALIBRATION_WAVELENGTHS = 16
+MDF_CALIBRATION_SIZE = 256  # the MDF plot's, timed with the first part
 # Before it, a render is priced at the built-in guess (4× the slowest preset); the
 # calibration's renders are mostly of cheaper presets: counted whole, it was predicted at
 # 28.5 s where it took 7-9 s (llvmpipe, 2 cores), and a fresh server's first client was
@@ -68,6 +71,8 @@ class CalibrateTask:
         tiny = RenderRequest(width=16, height=16, samples=1, wavelengths=0, quality="draft")
         overhead = self._time_task(renderer, ImageTask(prepare(tiny, PRIVATE)), should_stop)[1]
         units = CALIBRATION_SIZE * CALIBRATION_SIZE * CALIBRATION_SAMPLES
+        if self.part == 0:
+            timings[MDF_LABEL] = self._time_plots(renderer, should_stop, units)
         return json.dumps({"part": self.part, "parts": self.parts,
                            "overhead_s": overhead, "units": units,
                            "wavelengths": CALIBRATION_WAVELENGTHS, "timings": timings,
@@ -80,8 +85,20 @@ class CalibrateTask:
                              height=CALIBRATION_SIZE, samples=CALIBRATION_SAMPLES,
                              wavelengths=wavelengths, environment=environment)
 
+    def _time_plots(self, renderer: Any, should_stop: StopCheck, units: int) -> list[float]:
+        """The MDF plot's seconds at 0 and the calibration's wavelengths, the dearer of the
+        two MDFs, scaled to ``units`` pixels (a plot has no samples). Unpriced, a plot was
+        priced as the slowest preset: a 384² plot was refused as 21.5 s, and took 0.05."""
+        side = MDF_CALIBRATION_SIZE
+        found = []
+        for wavelengths in (0, CALIBRATION_WAVELENGTHS):
+            found.append(max(self._time_task(renderer, MdfTask(Material(mdf=mdf), side, "png",
+                                                               wavelengths), should_stop)[1]
+                             for mdf in ("ashikhmin", "multipeak")) * units / side ** 2)
+        return found
+
     @staticmethod
-    def _time_task(renderer: Any, task: ImageTask, should_stop: StopCheck
+    def _time_task(renderer: Any, task: ImageTask | MdfTask, should_stop: StopCheck
                    ) -> tuple[float, float]:
         """Seconds of the variant's first render (its compile, its scene) and of the next."""
         seconds = []

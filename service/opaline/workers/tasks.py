@@ -20,10 +20,9 @@ from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared
 from opaline.pipeline.produce import produce
 from opaline.scene.environments import BUILTIN
-from opaline.workers.admission import mesh_cost_s, shading_index
+from opaline.workers.admission import MDF_LABEL, mesh_cost_s, shading_index
 
 StopCheck = Callable[[], bool]
-MDF_LABEL = "mdf-plot"
 
 
 def no_meshes(request: RenderRequest, preset: Preset) -> Preset:
