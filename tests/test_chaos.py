@@ -162,6 +162,29 @@ def test_slow_body_is_408(server, capsys):
     assert answer.startswith(b"HTTP/1.1 408") and b'"error": "timeout"' in answer
 
 
+def test_a_slow_upload_that_keeps_coming_is_not_cut_off(server, capsys):
+    """The body's time grows with what arrives (a second per OPALINE_MIN_BODY_RATE bytes,
+    16 KiB by default): an upload at 32 KiB/s took longer than the 2 s body timeout and
+    was answered 408 mid-way, however steadily it came."""
+    mesh = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    chunk = b"#" + b"." * 8190 + b"\n"
+    chunks = int(3 * READ_TIMEOUT_S * 4)  # 8 KiB every 0.25 s: three body timeouts long
+    body = mesh + chunk * chunks
+    sock = raw(server, b"POST /v1/meshes HTTP/1.1\r\nHost: x\r\n"
+                       b"Content-Length: " + str(len(body)).encode() + b"\r\n\r\n" + mesh)
+    started = time.monotonic()
+    for _ in range(chunks):
+        time.sleep(0.25)
+        sock.sendall(chunk)
+    sock.settimeout(30)
+    answer = sock.recv(4096)
+    sock.close()
+    took = time.monotonic() - started
+    figure(capsys, f"steady slow upload: {answer.split(b' ')[1].decode()} after {took:.1f} s")
+    assert took > 2 * READ_TIMEOUT_S
+    assert answer.startswith(b"HTTP/1.1 201"), answer[:300]
+
+
 @pytest.fixture(scope="module")
 def patient_server():
     """A server whose deadline admits the largest render, whatever the machine's speed."""

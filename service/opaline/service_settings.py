@@ -96,7 +96,11 @@ class Settings(BaseSettings):
     header_timeout_s: float = Field(
         10.0, gt=0, le=600, description="A connection must send a request's headers within this.")
     body_timeout_s: float = Field(
-        10.0, gt=0, le=600, description="A request's body must arrive within this.")
+        10.0, gt=0, le=600, description="A request's body must arrive within this, plus a "
+                                        "second for every min_body_rate bytes that arrived.")
+    min_body_rate: int = Field(
+        16384, ge=1, description="Bytes a second that earn a request's body more time past "
+                                 "body_timeout_s: a slower one is cut off with 408.")
     write_timeout_s: float = Field(
         30.0, gt=0, le=3600, description="A client that reads nothing for this long is dropped.")
     max_connections_per_client: int = Field(

@@ -7,7 +7,9 @@ uvicorn sets no header or body read timeout, so half-sent requests stayed open
 - a header timeout: a connection whose request head is not complete this long
   after it opened (or after its previous answer) is closed;
 - a body timeout: a request whose body is not complete this long after its
-  head answers 408 and is closed;
+  head, plus a second for every ``min_body_rate`` bytes that did arrive, answers
+  408 and is closed (a slow upload that keeps coming is not cut off; one that
+  trickles in is);
 - a write timeout: a client that takes nothing of an answer for this long is
   dropped (a chunked answer, ``opaline.server.streaming``, holds about one
   chunk for it meanwhile);
@@ -53,6 +55,7 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
         def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
             super().connection_made(transport)
             self._timer = self._write_timer = None
+            self._body_started, self._body_bytes = 0.0, 0
             self._address = self.client[0] if self.client else "unknown"
             per_client[self._address] += 1
             if len(self.connections) > settings.max_connections:
@@ -79,6 +82,11 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
                 return
             state = self.conn.their_state
             if state is h11.SEND_BODY and not (self.cycle and self.cycle.response_started):
+                earned = self._body_started + settings.body_timeout_s + (
+                    self._body_bytes / settings.min_body_rate)
+                if earned > self.loop.time():  # what arrived bought it more time
+                    self._arm(earned - self.loop.time())
+                    return
                 STATS["body_timeouts"] += 1
                 self.transport.write(raw_problem(408, "Request Timeout", "timeout",
                                                  "the request body did not arrive in time"))
@@ -101,7 +109,10 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
             super().data_received(data)
             after = self.conn.their_state
             if after is h11.SEND_BODY and before is not h11.SEND_BODY:
+                self._body_started, self._body_bytes = self.loop.time(), 0
                 self._arm(settings.body_timeout_s)
+            elif after is h11.SEND_BODY:
+                self._body_bytes += len(data)
             elif after is h11.DONE and self._timer is not None:
                 self._timer.cancel()
                 self._timer = None
