@@ -135,6 +135,20 @@ def test_options_and_405_name_every_method_of_the_path(client, path, allow):
     assert wrong.headers["allow"] == allow
 
 
+@pytest.mark.parametrize(("method", "path", "allow"), [
+    ("GET", "/v1/meshes", "OPTIONS, POST"), ("HEAD", "/v1/turntables", "OPTIONS, POST"),
+    ("POST", "/v1/mdf", "GET, HEAD, OPTIONS"), ("POST", "/healthz", "GET, HEAD, OPTIONS"),
+    ("POST", "/v1/presets", "GET, HEAD, OPTIONS")])
+def test_a_get_or_post_of_the_other_kind_of_route_is_the_same_405(client, method, path, allow):
+    """GET of a POST route, HEAD of one, POST of a GET route: Starlette's own 405 named
+    only that route's methods ("allow: POST") with its "Method Not Allowed"."""
+    wrong = client.request(method, path)
+    assert wrong.status_code == 405 and wrong.headers["allow"] == allow
+    if method != "HEAD":
+        assert wrong.json() == {"error": "method_not_allowed",
+                                "detail": [f"{method} is not allowed here"]}
+
+
 def test_unknown_path_is_404_in_the_public_shape(client):
     error(client.get("/v2/nothing"), 404, "not_found")
     error(client.options("/v2/nothing"), 404, "not_found")

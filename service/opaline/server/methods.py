@@ -49,6 +49,17 @@ def allowed_methods(app: Starlette, scope: Scope) -> set[str]:
     return methods | {"OPTIONS"} if methods else methods
 
 
+def mismatched(app: Starlette, scope: Scope) -> bool:
+    """Whether some route has this path but none this method (one pass, as routing's)."""
+    partial = False
+    for route in app.router.routes:
+        match = route.matches(scope)[0]
+        if match is Match.FULL:
+            return False
+        partial = partial or match is Match.PARTIAL
+    return partial
+
+
 def without_slash(app: Starlette, scope: Scope) -> str | None:
     """The path less its trailing slash where only that has a route. The app does not
     redirect there (redirect_slashes is off): Starlette's redirect wrote the request's
@@ -78,22 +89,22 @@ class Methods:
             await self.app(scope, receive, send)
             return
         method = scope["method"]
-        if method in ("HEAD", "OPTIONS"):
-            allowed = allowed_methods(self.routes_of, scope)
-            if method == "OPTIONS" and allowed:
-                allow = ", ".join(sorted(allowed))
-                await Response(status_code=204, headers={"Allow": allow})(scope, receive, send)
-                return
-            if method == "HEAD" and "GET" in allowed:
-                scope = {**scope, "method": "GET"}
-        elif method not in ("GET", "POST"):
-            # Starlette's 405 names only the first route's methods (POST on /v1/render)
-            allowed = allowed_methods(self.routes_of, scope)
-            if allowed and method not in allowed:
-                self.on_reject("method_not_allowed")
-                await problem(405, "method_not_allowed", f"{method} is not allowed here",
-                              headers={"Allow": ", ".join(sorted(allowed))})(scope, receive, send)
-                return
+        allowed = (allowed_methods(self.routes_of, scope)
+                   if method not in ("GET", "POST") or mismatched(self.routes_of, scope)
+                   else None)
+        if method == "OPTIONS" and allowed:
+            await Response(status_code=204, headers={"Allow": ", ".join(sorted(allowed))})(
+                scope, receive, send)
+            return
+        if method == "HEAD" and allowed and "GET" in allowed:
+            scope = {**scope, "method": "GET"}
+        elif allowed and method not in allowed:
+            # Starlette's 405 names only the first route's methods (POST on /v1/render,
+            # and for a GET of a POST route its own "Method Not Allowed")
+            self.on_reject("method_not_allowed")
+            await problem(405, "method_not_allowed", f"{method} is not allowed here",
+                          headers={"Allow": ", ".join(sorted(allowed))})(scope, receive, send)
+            return
         bare = without_slash(self.routes_of, scope)
         if bare:
             self.on_reject("not_found")
