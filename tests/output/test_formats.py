@@ -121,6 +121,12 @@ def test_auto_refuses_what_it_cannot_make(client):
     assert client.get(QUERY + "&format=auto", headers={"Accept": "text/html"}).status_code == 406
     answer = client.get(QUERY + "&format=jpeg&transparent=true")
     assert answer.status_code == 422 and "alpha" in answer.text
+    # Transparency, not the Accept header, is what rules JPEG out: the 406 says so (it said
+    # the header allowed none of the four, image/jpeg among them).
+    only_jpeg = client.get(QUERY + "&format=auto&transparent=true",
+                           headers={"Accept": "image/jpeg"})
+    assert only_jpeg.status_code == 406
+    assert "no alpha channel" in only_jpeg.json()["detail"][0], only_jpeg.text
 
 
 @pytest.mark.gl

@@ -101,6 +101,11 @@ def test_http_turntable_with_progress(backend):
         result = client.get(status["result"])
         assert result.status_code == 200 and result.headers["content-type"] == "image/webp"
         assert decode(result.content, "webp") == (8, (64, 64))
+        # As every image answer: a strong ETag, 304 on it, Cache-Control, Server-Timing.
+        assert result.headers["etag"].startswith('"') and "cache-control" in result.headers
+        assert result.headers["server-timing"].startswith("hit")
+        again = client.get(status["result"], headers={"If-None-Match": result.headers["etag"]})
+        assert again.status_code == 304 and again.content == b""
         for path in ("/v1/turntables/nope", "/v1/turntables/nope/result"):
             unknown = client.get(path)
             assert unknown.status_code == 404 and unknown.json()["error"] == "unknown_turntable"

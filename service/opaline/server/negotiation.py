@@ -38,7 +38,12 @@ def server_timing(started: float, source: str, render_s: float | None = None) ->
 
 def negotiated(params: RenderRequest, request: Request) -> RenderRequest:
     """``format=auto`` replaced by the format the Accept header prefers (406 if none)."""
-    fmt = negotiate(request.headers.get("accept"), alpha=bool(params.transparent))
+    accept = request.headers.get("accept")
+    fmt = negotiate(accept, alpha=bool(params.transparent))
+    if fmt is None and negotiate(accept, alpha=False) is not None:
+        raise HTTPException(406, "format=auto with transparent=true: the Accept header allows "
+                            "only image/jpeg, which has no alpha channel; accept image/webp, "
+                            "image/avif or image/png")
     if fmt is None:
         raise HTTPException(406, "format=auto: the Accept header allows none of image/webp, "
                             "image/avif, image/png, image/jpeg")

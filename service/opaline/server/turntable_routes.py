@@ -21,6 +21,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import Response
 
 from opaline.output.animation import EXTENSIONS, MEDIA_TYPES
+from opaline.server.cache import etag, matches
 from opaline.server.deps import LanesDep, ServiceDep, TurntablesDep
 from opaline.server.errors import (
     ERROR_RESPONSES,
@@ -30,8 +31,9 @@ from opaline.server.errors import (
     StillRendering,
     UnknownTurntable,
 )
+from opaline.server.negotiation import Started, server_timing
 from opaline.server.queries import refuse_query
-from opaline.server.render_routes import RENDER_RESPONSES
+from opaline.server.render_routes import CONDITIONAL, ETAG, RENDER_RESPONSES
 from opaline.server.statestore import Record
 from opaline.server.turntable_jobs import StoredFailure, Turntables, new_job
 from opaline.server.turntable_runs import (
@@ -59,7 +61,8 @@ READ_404 = {"model": Problem, "description": UNKNOWN_LINE + CANCELLED_LINE}
 RESULT_RESPONSES: dict[int | str, dict[str, Any]] = {
     200: {"description": "The animation: animated WebP, GIF or MP4.",
           "content": {t: {"schema": {"type": "string", "format": "binary"}}
-                      for t in MEDIA_TYPES.values()}},
+                      for t in MEDIA_TYPES.values()}, "headers": ETAG},
+    **CONDITIONAL,
     **ERROR_RESPONSES,
     404: {"model": Problem, "description": UNKNOWN_LINE + CANCELLED_LINE + " Also: its "
                                            "animation was forgotten (a byte budget keeps the "
@@ -131,7 +134,7 @@ async def turntable_get(turntable_id: str, svc: ServiceDep, found: TurntablesDep
             response_class=Response, responses=RESULT_RESPONSES,
             summary="The finished animation (409 while it renders)")
 async def turntable_result(turntable_id: str, svc: ServiceDep, found: TurntablesDep,
-                           shared: LanesDep) -> Response:
+                           shared: LanesDep, request: Request, started: Started) -> Response:
     entry = await current(svc, found, turntable_id, shared)
     if entry["state"] == "failed" and entry["failure"] is not None:
         raise StoredFailure(entry["failure"])  # its own public status and reason
@@ -143,5 +146,12 @@ async def turntable_result(turntable_id: str, svc: ServiceDep, found: Turntables
         raise StillRendering(f"still rendering: {entry['done']} of {entry['frames']} frames "
                              "done")
     fmt = entry["fmt"]
-    headers = {"Content-Disposition": f'inline; filename="turntable{EXTENSIONS[fmt]}"'}
+    # As every image answer: a strong ETag (304 on a match), Cache-Control, Server-Timing.
+    tag = etag(data)
+    headers = {"ETag": tag, "Cache-Control": f"public, max-age={svc.settings.cache_max_age_s}"}
+    if matches(request.headers.get("if-none-match"), tag):
+        headers["Server-Timing"] = server_timing(started, "revalidated")
+        return Response(status_code=304, headers=headers)
+    headers["Content-Disposition"] = f'inline; filename="turntable{EXTENSIONS[fmt]}"'
+    headers["Server-Timing"] = server_timing(started, "hit")
     return Response(data, media_type=MEDIA_TYPES[fmt], headers=headers)
