@@ -56,3 +56,29 @@ def test_every_tuple_field_takes_commas(name):
     fields = parse_sets([f"{name}=1,0,0"])
     request = RenderRequest(preset="tempered-steel", metal="artist", **fields)
     assert getattr(request, name) == (1.0, 0.0, 0.0)  # before: metal_f0 "a valid tuple"
+
+
+@pytest.mark.parametrize(("text", "words"), [
+    ('{"preset": "cd-rom", "mu_f": "6"}', "mu_f='6': Input should be a valid number"),
+    ('{"preset": "cd-rom", "transparent": "yes"}', "transparent='yes'"),
+    ('{"preset": "cd-rom", "width": "64"}', "width='64': Input should be a valid integer"),
+    ('{"preset": "cd-rom", "mu_f": 6, "mu_f": 7}', "mu_f: given more than once"),
+    ('preset = "cd-rom"\nmu_f = "6"\n', "m.toml:2: mu_f='6'"),
+])
+def test_a_material_file_is_read_as_the_api_reads_a_body(capsys, tmp_path, text, words):
+    """docs/materials.md: a file is the same request POST /v1/render takes; the file took
+    strings for numbers and booleans, and the last of a key given twice, where the API
+    answers 422."""
+    path = tmp_path / ("m.toml" if text.startswith("preset =") else "m.json")
+    path.write_text(text)
+    line = one_line_error(capsys, "render", str(path), "-o", str(tmp_path / "x.png"))
+    assert words in line
+
+
+def test_a_files_integral_float_and_the_command_lines_strings_are_taken(tmp_path):
+    from opaline.model.material_file import load_material
+
+    path = tmp_path / "m.json"
+    path.write_text('{"preset": "cd-rom", "width": 64.0, "mu_f": 6}')
+    request = load_material(path, parse_sets(["mu_f=7", "transparent=true"]))
+    assert (request.width, request.mu_f, request.transparent) == (64, 7.0, True)

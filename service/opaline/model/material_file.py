@@ -18,6 +18,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from opaline.model.params import RenderRequest, describe_errors
+from opaline.model.strict_json import DuplicateKey, refuse_duplicate_keys, validate_strictly
 
 SUFFIXES = (".toml", ".json")
 SCHEMA_KEY = "$schema"  # allowed in files so editors can find the schema; ignored
@@ -51,6 +52,10 @@ def read_text_table(path: Path) -> tuple[dict[str, Any], str]:
     is_json = path.suffix.lower() == ".json"
     try:
         data = json.loads(text) if is_json else tomllib.loads(text)
+        if is_json:  # TOML refuses a key given twice itself
+            refuse_duplicate_keys(text, "the file")
+    except DuplicateKey as exc:
+        raise MaterialError(f"{path}: {exc}", path) from None
     except json.JSONDecodeError as exc:
         raise MaterialError(f"{at(path, exc.lineno)}: invalid JSON: {exc}", path,
                             exc.lineno) from None
@@ -87,10 +92,18 @@ def locate(path: Path | str, key: str) -> int | None:
         return None
 
 
-def parse_request(fields: dict[str, Any], where: str) -> RenderRequest:
+def validate(fields: dict[str, Any], lax: Iterable[str] = ()) -> RenderRequest:
+    """Fields as a request: a file's strictly, as the API reads a JSON body ({"mu_f": "6"} is
+    refused), the ``lax`` ones (the command line's --set strings) as pydantic parses them."""
+    lax = set(lax)
+    validate_strictly({k: v for k, v in fields.items() if k not in lax}, RenderRequest)
+    return RenderRequest.model_validate(fields)
+
+
+def parse_request(fields: dict[str, Any], where: str, lax: Iterable[str] = ()) -> RenderRequest:
     """Validate fields with the request model; errors name ``where``, the field and the range."""
     try:
-        return RenderRequest.model_validate(fields)
+        return validate(fields, lax)
     except ValidationError as exc:
         raise MaterialError(f"{where}: " + "; ".join(describe_errors(exc))) from None
 
@@ -110,7 +123,7 @@ def load_material(path: Path | str, overrides: dict[str, Any] | None = None) -> 
         # A mesh written in the file is relative to the file, as an editor sees it.
         fields["mesh"] = str(path.parent / Path(fields["mesh"]).expanduser())
     try:
-        return RenderRequest.model_validate(fields)
+        return validate(fields, set(fields) - own)
     except ValidationError as exc:
         line = _first_line(exc, text, own, path.suffix.lower() == ".json")
         raise MaterialError(f"{at(path, line)}: " + "; ".join(describe_errors(exc)), path,

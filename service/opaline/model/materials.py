@@ -128,7 +128,7 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any]
             where = f"{manifest}[{name}] ({ref})"
         merged.update(fields)
         merged.update(overrides)
-        request = parse_request(merged, where)
+        request = parse_request(merged, where, lax=overrides)
     except MaterialError as exc:
         return failed(prefix + name, where, exc, manifest)
     return Item(prefix + name, where, request, file=str(manifest))

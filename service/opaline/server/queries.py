@@ -7,14 +7,12 @@ each time; every other field is the request model's own.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
-from functools import cache
 from types import NoneType, UnionType
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin
 
 from pydantic import BaseModel, Field, field_validator
-from pydantic_core import from_json, to_json
+from pydantic_core import from_json
 
 from opaline.errors import PublicError
 from opaline.model.material import Unit
@@ -26,6 +24,7 @@ from opaline.model.params import (
     wavelengths_ok,
     wavelengths_schema,
 )
+from opaline.model.strict_json import refuse_duplicate_keys, validate_strictly
 
 
 def _comma_list(value: Any) -> Any:
@@ -99,24 +98,6 @@ def refuse_query(query: Mapping[str, str]) -> None:
                           f"string ({shown}): send them in the body")
 
 
-class DuplicateKey(PublicError, ValueError):
-    """A body naming a key twice in one object: JSON leaves which one counts to the
-    parser (RFC 8259 §4), and the last silently won (422)."""
-
-    status, reason = 422, "invalid"
-
-
-def _refuse_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    found: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in found:
-            name = key if key.isidentifier() else json.dumps(key)[:80]
-            raise DuplicateKey(f"{name}: given more than once in one object of the JSON body "
-                               "(which one counts is the parser's choice): give it once")
-        found[key] = value
-    return found
-
-
 Model = TypeVar("Model", bound=BaseModel)
 
 
@@ -139,18 +120,5 @@ def parse_body(raw: bytes, model: type[Model]) -> Model:
         raise Malformed(f"body: not valid JSON ({exc})") from None
     # Parsed again only to see every key (pydantic's parser keeps the last of a repeated
     # one); its nesting is already bounded by the parse above.
-    json.loads(raw, object_pairs_hook=_refuse_duplicates)
-    if isinstance(data, dict):
-        for name in integer_fields(model) & data.keys():
-            value = data[name]
-            if isinstance(value, float) and value.is_integer():
-                data[name] = int(value)
-    return model.model_validate_json(to_json(data, inf_nan_mode="constants"), strict=True)
-
-
-@cache
-def integer_fields(model: type[BaseModel]) -> frozenset[str]:
-    """The fields whose JSON type is integer (alone or beside null)."""
-    props = model.model_json_schema()["properties"]
-    return frozenset(name for name, prop in props.items()
-                     if "integer" in {alt.get("type") for alt in prop.get("anyOf", [prop])})
+    refuse_duplicate_keys(raw, "the JSON body")
+    return validate_strictly(data, model)
