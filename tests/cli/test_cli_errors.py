@@ -21,10 +21,12 @@ def one_line_error(capsys, *argv: str) -> str:
     return lines[0]
 
 
-@pytest.mark.gl
-@pytest.mark.usefixtures("shared_renderer")
 @pytest.mark.parametrize("command", ["render", "turntable"])
-def test_a_limit_is_one_line(capsys, tmp_path, command):
+def test_a_limit_is_one_line(capsys, tmp_path, command, monkeypatch):
+    """One line, rc 2, found before a GL context opens (none can be made here)."""
+    from opaline.local import pipeline
+
+    monkeypatch.setattr(pipeline, "LocalRenderer", None)  # any use of it fails
     out = tmp_path / ("t.jpg" if command == "render" else "t.webp")
     argv = [command, "cd-rom", *TINY, "--set", "transparent=true", "-o", str(out)]
     if command == "turntable":
@@ -82,3 +84,23 @@ def test_a_files_integral_float_and_the_command_lines_strings_are_taken(tmp_path
     path.write_text('{"preset": "cd-rom", "width": 64.0, "mu_f": 6}')
     request = load_material(path, parse_sets(["mu_f=7", "transparent=true"]))
     assert (request.width, request.mu_f, request.transparent) == (64, 7.0, True)
+
+
+@pytest.mark.parametrize(("argv", "words"), [
+    (["mdf", "--size", "64", "-o", "m.jpg"], "this command writes png or npy, not jpeg"),
+    (["turntable", "cd-rom", "--format", "gif", "-o", "t.webp"],
+     "--format gif does not match -o"),
+])
+def test_a_format_the_output_cannot_hold_is_refused(capsys, tmp_path, argv, words):
+    """README: a format that does not match the extension is an error; the MDF plot wrote
+    PNG bytes to m.jpg, the turntable a GIF to t.webp."""
+    argv = [tmp_path / a if a.endswith((".jpg", ".webp")) else a for a in argv]
+    assert words in one_line_error(capsys, *map(str, argv))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_material_files_format_must_fit_the_extension(capsys, tmp_path):
+    path = tmp_path / "m.json"
+    path.write_text('{"preset": "cd-rom", "format": "npy"}')
+    line = one_line_error(capsys, "render", str(path), "-o", str(tmp_path / "x.png"))
+    assert "format npy does not match -o" in line  # it wrote an 8-bit PNG

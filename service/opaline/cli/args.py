@@ -115,23 +115,27 @@ def load_request(source: str, fields: dict[str, Any]) -> RenderRequest:
 
 def output_format(output: str, wanted: str | None, own: str | None = None,
                   allowed: tuple[str, ...] = get_args(ImageFormat)) -> str:
-    """The format to write ``output`` in: ``--format`` if given (it must fit a known
-    extension), else the request's ``own`` format if the extension fits it, else what
-    the extension means; png for stdout."""
+    """The format to write ``output`` in: ``--format`` if given, else the format a material
+    file names (``own``), else what the extension means; png for stdout. A format the
+    extension cannot hold, or one this command cannot write, is an error."""
     if wanted is not None and wanted not in allowed:
         raise CliError(f"format={wanted!r}: expected one of {', '.join(allowed)}")
     fits = FORMATS_BY_SUFFIX.get(Path(output).suffix.lower()) if output != STDOUT else None
-    if wanted:
-        if fits and wanted not in fits:
-            raise CliError(f"--format {wanted} does not match -o {output}: {wanted} files end "
-                           f"in {EXTENSIONS[wanted]}")
-        return wanted
+    if fits is not None and not set(fits) & set(allowed):
+        raise CliError(f"-o {output}: this command writes {' or '.join(allowed)}, not "
+                       f"{fits[0]}: use {' or '.join(EXTENSIONS[f] for f in allowed)}")
+    for given, said in ((wanted, "--format"), (own, "format")):
+        if given and fits and given not in fits:
+            raise CliError(f"{said} {given} does not match -o {output}: {given} files end "
+                           f"in {EXTENSIONS[given]}")
+        if given:
+            return given
     if output == STDOUT:
-        return own if own in allowed else "png"
+        return "png"
     if not fits:
         raise CliError(f"-o {output}: cannot tell the format from the extension: "
                        "use .png, .npy, .webp, .avif or .jpg, or give --format")
-    return own if own in fits and own in allowed else fits[0]
+    return next(f for f in fits if f in allowed)
 
 
 def write_output(output: str, data: bytes) -> None:

@@ -29,17 +29,23 @@ log = logging.getLogger("opaline.cli")
 
 
 def cmd_render(args: argparse.Namespace) -> None:
+    from opaline.local.context import local_context
     from opaline.local.pipeline import LocalRenderer
+    from opaline.pipeline.prepare import prepare
+    from opaline.settings import setting
 
     fields: dict[str, Any] = source_fields(args)
     wanted = args.format or fields.pop("format", None)  # --set format=X is --format X
     if args.transparent:
         fields["transparent"] = True
     request = load_request(args.source, fields)
-    fmt = output_format(args.output, wanted, request.format)
+    # A format the material file names must fit the extension; the model's default need not.
+    own = request.format if "format" in request.model_fields_set else None
+    fmt = output_format(args.output, wanted, own)
     request = request.model_copy(update={"format": fmt})
+    # Prepared (checked against the limits) before a GL context opens: a refusal costs none.
+    prepared = prepare(request, local_context(setting("cost_budget")))
     with LocalRenderer(args.backend) as renderer:
-        prepared = renderer.prepare(request)
         job = prepared.job
         log.info("preset=%s %dx%d %s quality=%s samples=%d wavelengths=%d aa=%s cost=%d",
                  job.preset, job.width, job.height, job.format, job.quality, job.samples,

@@ -28,12 +28,18 @@ SUFFIXES: dict[str, AnimationFormat] = {".webp": "webp", ".gif": "gif", ".mp4": 
 
 
 def cmd_turntable(args: argparse.Namespace) -> None:
+    from opaline.local.context import local_context
     from opaline.local.pipeline import LocalRenderer
     from opaline.local.turntable import turntable_bytes
-    from opaline.model.turntable import TurntableRequest
+    from opaline.model.turntable import TurntableRequest, check_turntable_cost
+    from opaline.pipeline.prepare import prepare
+    from opaline.settings import setting
 
     base = load_request(args.source, source_fields(args))
     suffix = next((s for s in SUFFIXES if args.output.lower().endswith(s)), None)
+    if args.format and suffix and SUFFIXES[suffix] != args.format:
+        raise CliError(f"--format {args.format} does not match -o {args.output}: "
+                       f"{args.format} files end in .{args.format}")
     fmt = args.format or (SUFFIXES[suffix] if suffix else None)
     if fmt is None:
         raise CliError(f"-o {args.output}: give --format webp|gif|mp4 or a .webp/.gif/.mp4 name")
@@ -42,6 +48,10 @@ def cmd_turntable(args: argparse.Namespace) -> None:
                                    fps=args.fps, animation=fmt)
     except ValidationError as exc:  # frames, fps: named with their range, as the API does
         raise CliError("; ".join(describe_errors(exc, TurntableRequest))) from None
+    # Checked (limits, the budget over all frames) before a GL context opens.
+    budget = setting("cost_budget")
+    check_turntable_cost(prepare(request.still(), local_context(budget)).job, request.frames,
+                         budget)
     started = time.perf_counter()
 
     def progress(done: int, total: int) -> None:
