@@ -201,6 +201,19 @@ def test_mdf_plot_png_and_npy(client):
     assert "etag" in raw.headers
 
 
+def test_a_field_the_plot_does_not_read_gives_no_second_url(client):
+    """kd, a film's index, a tangent axis leave the plot alone: it had one image under as
+    many URLs and revs as such fields were spelled (the ETag alone was the same)."""
+    plain = client.get("/v1/mdf?size=32&mu_f=3")
+    for extra in ("kd=3", "film_ior=2", "iridescence=thin-film", "coat_weight=1"):
+        other = client.get(f"/v1/mdf?size=32&mu_f=3&{extra}")
+        assert other.status_code == 200
+        assert other.headers["content-location"] == plain.headers["content-location"]
+        assert other.headers["etag"] == plain.headers["etag"]
+    moved = client.get("/v1/mdf?size=32&mu_f=4")
+    assert moved.headers["content-location"] != plain.headers["content-location"]
+
+
 def test_presets_list(client):
     """GET /v1/presets lists every preset with description, figure, geometry and defaults."""
     listed = {p["name"]: p for p in client.get("/v1/presets").json()}

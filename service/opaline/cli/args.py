@@ -11,6 +11,7 @@ from typing import Any, get_args, get_origin
 
 from pydantic import ValidationError
 
+from opaline.model.material import MDF_PLOT_FIELDS
 from opaline.model.material_file import MaterialError, load_material
 from opaline.model.params import (
     ImageFormat,
@@ -156,7 +157,7 @@ def write_output(output: str, data: bytes) -> None:
         raise OutputError(f"cannot write {output}: {exc.strerror or exc}") from None
 
 
-PLOT_FIELDS = ("mdf", "ex", "ey", "mu_f", "alpha", "beta", "theta1", "theta2", "wavelengths")
+PLOT_FIELDS = (*MDF_PLOT_FIELDS, "wavelengths")
 WAVELENGTHS_HELP = ("0 = the paper's RGB rotations (default), else 3 … 128 wavelengths "
                     "integrated with CIE 1931.")
 

@@ -196,6 +196,9 @@ class Material(BaseModel):
 
 
 MATERIAL_FIELDS = tuple(Material.model_fields)
+# The material fields an MDF plot depends on (Figs. 2-8): the rest (colour source, film,
+# grating, coat, kd ...) leave it alone, and a plot's key and URL ignore them.
+MDF_PLOT_FIELDS = ("mdf", "ex", "ey", "mu_f", "alpha", "beta", "theta1", "theta2")
 
 
 def _optional(name: str) -> Any:

@@ -21,7 +21,8 @@ from urllib.parse import urlencode
 
 from pydantic import Field
 
-from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
+from opaline.model.material import MDF_PLOT_FIELDS
+from opaline.model.params import Material, RenderRequest
 from opaline.pipeline.canonical import spell
 from opaline.server.queries import MdfQuery, RenderQuery
 
@@ -58,12 +59,17 @@ class CanonicalMdfQuery(MdfQuery):
         return MdfQuery(**self.model_dump(exclude={"rev"}, exclude_none=True))
 
 
+def plot_material(params: MdfQuery) -> Material:
+    """The plot's material: its MDF fields, every other field at its default (a field the
+    plot does not read must not give one image a second URL and key)."""
+    return Material(**params.model_dump(include=set(MDF_PLOT_FIELDS), exclude_none=True))
+
+
 def canonical_plot(params: MdfQuery) -> tuple[MdfQuery, dict[str, str]]:
     """An MDF plot's query without what the defaults give (material fields against
     ``Material()``), spelled once and read back, as ``canonical_job`` does for renders."""
-    material, default = Material(**params.model_dump(include=set(MATERIAL_FIELDS),
-                                                     exclude_none=True)), Material()
-    query = {name: spell(getattr(material, name)) for name in MATERIAL_FIELDS
+    material, default = plot_material(params), Material()
+    query = {name: spell(getattr(material, name)) for name in MDF_PLOT_FIELDS
              if getattr(material, name) != getattr(default, name)}
     query.update({name: spell(getattr(params, name)) for name in ("size", "format", "wavelengths")
                   if getattr(params, name) != MdfQuery.model_fields[name].default})

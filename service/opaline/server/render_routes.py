@@ -17,7 +17,7 @@ from fastapi import APIRouter, Depends, Request
 from fastapi.responses import Response
 
 from opaline.model.auto import auto_headers
-from opaline.model.params import MATERIAL_FIELDS, Material, RenderRequest
+from opaline.model.params import RenderRequest
 from opaline.model.request import check_plot_cost
 from opaline.output.encode import EXTENSIONS, MEDIA_TYPES
 from opaline.pipeline.limits import LimitError, over_limit
@@ -30,6 +30,7 @@ from opaline.server.canonical import (
     canonical_plot,
     is_canonical,
     mdf_url,
+    plot_material,
 )
 from opaline.server.deps import ServiceDep
 from opaline.server.errors import ERROR_RESPONSES, Problem
@@ -168,7 +169,7 @@ async def mdf_get(started: Started,
                   request: Request, svc: ServiceDep) -> Response:
     params, canonical = canonical_plot(query.plot())
     check_mdf_limits(params, svc.settings)
-    material = Material(**params.model_dump(include=set(MATERIAL_FIELDS), exclude_none=True))
+    material = plot_material(params)
     key = mdf_key(material, params.size, params.format, params.wavelengths)
     url = mdf_url(canonical, key)
     headers = {"Content-Location": url}
