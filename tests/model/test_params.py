@@ -236,3 +236,12 @@ def test_models_are_frozen():
     request = RenderRequest(mu_f=2.0)
     with pytest.raises(ValidationError):
         request.mu_f = 2000.0
+
+
+@pytest.mark.parametrize(("given", "kept"), [
+    ((0.0, 2.0, 0.0), None), ((0.0, 1.0, 0.0), None), ((0.0, 0.0, 0.0), None),
+    ((3.0, 0.0, 4.0), (0.6, 0.0, 0.8)), ((0.0, 0.0, -5.0), (0.0, 0.0, -1.0))])
+def test_a_tangent_axis_is_kept_as_its_direction(given, kept):
+    """Only the axis's direction draws: 0,2,0 rendered the default's image under a key and
+    a canonical URL of its own, and an explicit 0,1,0 was kept in the URL."""
+    assert RenderRequest(tangent_axis=given).tangent_axis == kept

@@ -10,6 +10,7 @@ what is uploaded to the GPU (a turntable reuses one upload for every frame).
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
@@ -52,9 +53,15 @@ class SceneFields(BaseModel):
     def _direction(cls, axis: Finite3 | None) -> Finite3 | None:
         # Every schema-valid value is accepted (the schema cannot state a length): one with
         # no direction means the default, decided here, before a worker builds the field.
-        if axis is not None and sum(c * c for c in axis) < 1e-18:
+        # Only its direction counts, so it is kept as a unit vector and the default's
+        # direction is the default: 0,2,0 and 0,1,0 are one image, with one URL and key.
+        if axis is None:
             return None
-        return axis
+        length = math.sqrt(sum(c * c for c in axis))
+        if length < 1e-9:
+            return None
+        unit = (axis[0] / length, axis[1] / length, axis[2] / length)
+        return None if unit == (0.0, 1.0, 0.0) else unit
     camera_azimuth: Annotated[float, Field(ge=-360.0, le=360.0)] | None = Field(
         None, description="Camera azimuth in degrees around the target's up axis "
                           "(0: +x, 90: +z), -360 … 360 (default: the preset's view).")
