@@ -209,3 +209,11 @@ def test_every_error_status_is_documented_with_the_problem_shape(client):
                     ref = answer["content"]["application/json"]["schema"]["$ref"]
                     assert ref.endswith("/Problem"), (path, method, status)
     assert "HTTPValidationError" not in spec["components"]["schemas"]
+
+
+def test_a_long_unknown_name_is_not_echoed_whole(client):
+    """A 60 KB unknown query name was echoed whole in detail and twice in fields."""
+    answer = client.get("/v1/render?" + "x" * 60000 + "=1")
+    assert answer.status_code == 422 and len(answer.content) < 4096
+    assert answer.json()["fields"][0]["field"] == "x" * 63 + "…"
+    assert answer.json()["detail"][0].startswith("x" * 63 + "…: unknown field")

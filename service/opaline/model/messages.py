@@ -97,6 +97,15 @@ def _owner(model: type[BaseModel], loc: tuple[int | str, ...]) -> tuple[type[Bas
     return owner, name
 
 
+NAME_SHOWN = 64  # an unknown name longer than any field's is cut to this in a message
+
+
+def shown_name(name: str) -> str:
+    """An unknown field's name as a message echoes it: a 100 KB name was echoed whole in
+    each of the answer's lines and fields (a 301 KB body)."""
+    return name if len(name) <= NAME_SHOWN else name[:NAME_SHOWN - 1] + "…"
+
+
 def describe_errors(exc: ValidationError | list[dict[str, Any]], model: type[BaseModel]) -> list[str]:
     """One line per problem: the field, the value given, and what is allowed.
 
@@ -118,7 +127,7 @@ def describe_errors(exc: ValidationError | list[dict[str, Any]], model: type[Bas
             near = difflib.get_close_matches(name, known, n=1)  # "muf" → mu_f
             hint = f", did you mean {near[0]}?" if near else ""
             listed = f" (known fields: {', '.join(known)})" if unknown == 1 else ""
-            lines.append(f"{where}: unknown field{hint}{listed}")
+            lines.append(f"{shown_name(where)}: unknown field{hint}{listed}")
         elif kind == "missing" and isinstance(err["loc"][-1], int):
             lines.append(f"{name}: expected {_tuple_length(owner, name)} values, got fewer")
         elif kind == "missing":

@@ -24,7 +24,7 @@ from starlette.exceptions import HTTPException
 from starlette.requests import ClientDisconnect
 
 from opaline.errors import PublicError
-from opaline.model.messages import UNKNOWN_NAMED
+from opaline.model.messages import UNKNOWN_NAMED, shown_name
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.turntable import TurntableRequest
 from opaline.pipeline.limits import LimitError as LimitError
@@ -141,7 +141,8 @@ def _validation_fields(errors: Sequence[Mapping[str, Any]], model: type[BaseMode
             if unknown > UNKNOWN_NAMED:  # as many as detail names; it counts the rest
                 continue
         if name is not None:
-            found.extend({"field": name, "message": line} for line in lines_of([err], model))
+            found.extend({"field": shown_name(name), "message": line}
+                         for line in lines_of([err], model))
     return found
 
 
