@@ -90,6 +90,7 @@ def test_http_turntable_with_progress(backend):
             "animation": "webp"})
         assert started.status_code == 202, started.text
         status = started.json()
+        assert started.headers["location"] == f"/v1/turntables/{status['id']}"
         deadline = time.monotonic() + 60
         progress = []
         while status["state"] == "running" and time.monotonic() < deadline:

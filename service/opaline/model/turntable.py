@@ -30,7 +30,8 @@ class TurntableRequest(RenderRequest):
     fps: Annotated[int, Field(ge=1, le=60)] = Field(24, description="Frames per second, 1 … 60.")
     animation: AnimationFormat = Field(
         "webp", description="'webp' (animated WebP, the one with an alpha channel: "
-                            "transparent=true), 'gif' or 'mp4' (H.264).")
+                            "transparent=true), 'gif' or 'mp4' (H.264, yuv420p: an odd width or height "
+                            "gains one edge pixel).")
 
     @field_validator("animation")
     @classmethod

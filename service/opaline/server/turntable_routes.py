@@ -85,8 +85,8 @@ BODY = {"requestBody": {"required": True, "content": {
 @router.post("/v1/turntables", tags=["turntables"], status_code=202, openapi_extra=BODY,
              responses={**ERROR_RESPONSES, 404: RENDER_404, 429: BUSY},
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
-async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep,
-                         shared: LanesDep) -> TurntableStatus:
+async def turntable_post(request: Request, response: Response, svc: ServiceDep,
+                         found: TurntablesDep, shared: LanesDep) -> TurntableStatus:
     refuse_query(request.query_params)
     raw = await request.body()
     planned = plan(svc, raw)
@@ -100,7 +100,9 @@ async def turntable_post(request: Request, svc: ServiceDep, found: TurntablesDep
         record = (await start(svc, found, value, record.version if record else 0, shared,
                               planned)
                   or await found.read(key))  # or another replica started it first
-    return status_of(record.value)
+    status = status_of(record.value)
+    response.headers["Location"] = f"/v1/turntables/{status.id}"  # where to poll (RFC 9110)
+    return status
 
 
 async def restartable(found: Turntables, record: Record) -> bool:

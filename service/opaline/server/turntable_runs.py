@@ -145,7 +145,8 @@ async def adopt(svc: Service, found: Turntables, record: Record,
 
 def unknown_line(turntable_id: str) -> str:
     return (f"turntable {turntable_id!r} is not known here: start it with "
-            "POST /v1/turntables (finished ones are forgotten after 64)")
+            "POST /v1/turntables (one is forgotten OPALINE_TURNTABLE_KEEP_S after its last "
+            "change, its animation sooner past the kept animations' byte budget)")
 
 
 async def current(svc: Service, found: Turntables, turntable_id: str,
