@@ -162,6 +162,21 @@ def test_slow_body_is_408(server, capsys):
     assert answer.startswith(b"HTTP/1.1 408") and b'"error": "timeout"' in answer
 
 
+@pytest.mark.parametrize(("head", "status"), [
+    (b"GET /v1/render?mu_f=" + b"1" * 300000 + b" HTTP/1.1\r\nHost: x\r\n\r\n", b"431"),
+    (b"GET / HTTP/1.1\r\nHost: x\r\nX-Big: " + b"a" * 300000 + b"\r\n\r\n", b"431"),
+    (b"GARBAGE\r\n\r\n", b"400")])
+def test_a_head_too_large_is_431_and_garbage_400(server, head, status):
+    """A request head that outgrows h11's 16 KiB buffer was answered 400 "not valid
+    HTTP/1.1"; RFC 6585 has 431 for it (414 is for a URI the server parsed)."""
+    sock = raw(server, head)
+    sock.settimeout(10)
+    answer = sock.recv(4096)
+    sock.close()
+    assert answer.split(b" ")[1] == status, answer[:200]
+    assert b'"error": "malformed"' in answer
+
+
 def test_a_slow_upload_that_keeps_coming_is_not_cut_off(server, capsys):
     """The body's time grows with what arrives (a second per OPALINE_MIN_BODY_RATE bytes,
     16 KiB by default): an upload at 32 KiB/s took longer than the 2 s body timeout and

@@ -27,10 +27,13 @@ import json
 from collections import Counter
 
 import h11
+from h11._connection import DEFAULT_MAX_INCOMPLETE_EVENT_SIZE
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
 from opaline.settings import Settings
 
+# The request head h11 buffers at most (uvicorn leaves it at h11's default): past it, 431.
+HEAD_LIMIT = DEFAULT_MAX_INCOMPLETE_EVENT_SIZE
 # Refusals and timeouts since start, by kind: read by opaline.server.metrics.
 STATS: Counter[str] = Counter()
 
@@ -96,10 +99,17 @@ def guarded_protocol(settings: Settings) -> type[H11Protocol]:
                 self.transport.close()
 
         def send_400_response(self, msg: str) -> None:
-            """An unparsable request line or header: uvicorn's text/plain 400, in our shape."""
+            """An unparsable request line or header: uvicorn's text/plain 400, in our shape;
+            431 where the head outgrew h11's buffer (its error, not passed on, hints 431)."""
             STATS["malformed"] += 1
-            self.transport.write(raw_problem(400, "Bad Request", "malformed",
-                                             "the request is not valid HTTP/1.1"))
+            if len(self.conn.trailing_data[0]) > HEAD_LIMIT:
+                answer = raw_problem(431, "Request Header Fields Too Large", "malformed",
+                                     f"the request line and headers are over {HEAD_LIMIT} "
+                                     "bytes: send the parameters in a POST body")
+            else:
+                answer = raw_problem(400, "Bad Request", "malformed",
+                                     "the request is not valid HTTP/1.1")
+            self.transport.write(answer)
             self.transport.close()
 
         def data_received(self, data: bytes) -> None:
