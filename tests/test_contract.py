@@ -67,8 +67,11 @@ def test_a_key_given_twice_in_the_body_is_422_naming_it(client, path, body, name
     """{"mu_f": 2000, "mu_f": 1} was a 200 that used the last (pydantic's parser keeps it),
     though the first is out of range: which one counts is the parser's choice (RFC 8259
     §4). Now refused, with the key named."""
-    (line,) = error(client.post(path, content=body, headers=JSON), 422, "invalid")
+    answer = client.post(path, content=body, headers=JSON)
+    (line,) = error(answer, 422, "invalid")
     assert line.startswith(f"{name}: given more than once"), line
+    # fields names it too (it was empty): the key as written, not as the message quotes it
+    assert answer.json()["fields"] == [{"field": name.strip('"'), "message": line}]
 
 
 @pytest.mark.parametrize(("body", "words"), [

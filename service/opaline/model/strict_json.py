@@ -14,6 +14,7 @@ from pydantic import BaseModel
 from pydantic_core import to_json
 
 from opaline.errors import PublicError
+from opaline.model.messages import shown_name
 
 Model = TypeVar("Model", bound=BaseModel)
 
@@ -23,6 +24,13 @@ class DuplicateKey(PublicError, ValueError):
     8259 §4), and the last silently won (422)."""
 
     status, reason = 422, "invalid"
+
+    def __init__(self, message: str, field: str) -> None:
+        super().__init__(message)
+        self.field = field
+
+    def field_problems(self) -> list[dict[str, str]]:
+        return [{"field": self.field, "message": str(self)}]
 
 
 def refuse_duplicate_keys(text: str | bytes, where: str) -> None:
@@ -34,7 +42,8 @@ def refuse_duplicate_keys(text: str | bytes, where: str) -> None:
             if key in found:
                 name = key if key.isidentifier() else json.dumps(key)[:80]
                 raise DuplicateKey(f"{name}: given more than once in one object of {where} "
-                                   "(which one counts is the parser's choice): give it once")
+                                   "(which one counts is the parser's choice): give it once",
+                                   shown_name(key))
             found[key] = value
         return found
 
