@@ -130,5 +130,8 @@ def test_a_tangent_axis_with_no_direction_is_the_default():
     for axis in ((0, 0, 0), (5e-324, 0, 0), (1e-10, -1e-10, 0)):
         request = as_request({"preset": "cd-rom", "mesh": str(BUNNY), "tangent_axis": axis})
         assert request.tangent_axis is None, axis
-    kept = as_request({"preset": "cd-rom", "mesh": str(BUNNY), "tangent_axis": (0, 1e-3, 0)})
-    assert kept.tangent_axis == (0, 1e-3, 0)
+    # A short one keeps its direction, as a unit vector (the default's is the default).
+    kept = as_request({"preset": "cd-rom", "mesh": str(BUNNY), "tangent_axis": (1e-3, 0, 0)})
+    assert kept.tangent_axis == (1.0, 0.0, 0.0)
+    up = as_request({"preset": "cd-rom", "mesh": str(BUNNY), "tangent_axis": (0, 1e-3, 0)})
+    assert up.tangent_axis is None
