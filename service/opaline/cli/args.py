@@ -7,7 +7,7 @@ import argparse
 import difflib
 import sys
 from pathlib import Path
-from typing import Any, get_args, get_origin
+from typing import Any, get_args
 
 from pydantic import ValidationError
 
@@ -20,22 +20,13 @@ from opaline.model.params import (
     RenderRequest,
     describe_errors,
     field_range,
+    tuple_fields,
 )
 from opaline.output.encode import EXTENSIONS
 from opaline.output.files import write_atomic
 from opaline.settings import BACKENDS
 
-
-def _tuple_fields() -> frozenset[str]:
-    """The request's fields that take a tuple (albedo, metal_f0, ...): their --set value
-    is split at commas."""
-    def takes_tuple(annotation: Any) -> bool:
-        return get_origin(annotation) is tuple or any(takes_tuple(a) for a in get_args(annotation))
-    return frozenset(name for name, field in RenderRequest.model_fields.items()
-                     if takes_tuple(field.annotation))
-
-
-TUPLE_FIELDS = _tuple_fields()
+TUPLE_FIELDS = tuple_fields(RenderRequest)  # their --set value is split at commas
 MATERIAL_SUFFIXES = (".toml", ".json")
 # What an extension may hold: the first is what the extension alone means.
 FORMATS_BY_SUFFIX = {".png": ("png", "png16"), ".npy": ("npy",), ".webp": ("webp", "webp-lossless"),

@@ -29,10 +29,7 @@ log = logging.getLogger("opaline.cli")
 
 
 def cmd_render(args: argparse.Namespace) -> None:
-    from opaline.local.context import local_context
-    from opaline.local.pipeline import LocalRenderer
-    from opaline.pipeline.prepare import prepare
-    from opaline.settings import setting
+    from opaline.local.pipeline import LocalRenderer, prepare_locally
 
     fields: dict[str, Any] = source_fields(args)
     wanted = args.format or fields.pop("format", None)  # --set format=X is --format X
@@ -44,7 +41,7 @@ def cmd_render(args: argparse.Namespace) -> None:
     fmt = output_format(args.output, wanted, own)
     request = request.model_copy(update={"format": fmt})
     # Prepared (checked against the limits) before a GL context opens: a refusal costs none.
-    prepared = prepare(request, local_context(setting("cost_budget")))
+    prepared = prepare_locally(request)
     with LocalRenderer(args.backend) as renderer:
         job = prepared.job
         log.info("preset=%s %dx%d %s quality=%s samples=%d wavelengths=%d aa=%s cost=%d",

@@ -28,12 +28,9 @@ SUFFIXES: dict[str, AnimationFormat] = {".webp": "webp", ".gif": "gif", ".mp4": 
 
 
 def cmd_turntable(args: argparse.Namespace) -> None:
-    from opaline.local.context import local_context
     from opaline.local.pipeline import LocalRenderer
-    from opaline.local.turntable import turntable_bytes
-    from opaline.model.turntable import TurntableRequest, check_turntable_cost
-    from opaline.pipeline.prepare import prepare
-    from opaline.settings import setting
+    from opaline.local.turntable import prepare_turntable, turntable_bytes
+    from opaline.model.turntable import TurntableRequest
 
     base = load_request(args.source, source_fields(args))
     suffix = next((s for s in SUFFIXES if args.output.lower().endswith(s)), None)
@@ -48,17 +45,14 @@ def cmd_turntable(args: argparse.Namespace) -> None:
                                    fps=args.fps, animation=fmt)
     except ValidationError as exc:  # frames, fps: named with their range, as the API does
         raise CliError("; ".join(describe_errors(exc, TurntableRequest))) from None
-    # Checked (limits, the budget over all frames) before a GL context opens.
-    budget = setting("cost_budget")
-    check_turntable_cost(prepare(request.still(), local_context(budget)).job, request.frames,
-                         budget)
+    prepared = prepare_turntable(request)  # checked before a GL context opens
     started = time.perf_counter()
 
     def progress(done: int, total: int) -> None:
         log.info("frame %d/%d (%.1f s)", done, total, time.perf_counter() - started)
 
     with LocalRenderer(args.backend) as local:
-        data = turntable_bytes(local, request, progress)
+        data = turntable_bytes(local, request, progress, prepared)
     log.info("%d frames in %.2f s (%d bytes)", request.frames, time.perf_counter() - started,
              len(data))
     write_output(args.output, data)

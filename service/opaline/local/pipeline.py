@@ -30,6 +30,17 @@ class Rendered:
     media_type: str
 
 
+def budget_of(cost_budget: int | None) -> int:
+    """A local render's cost budget: as given, else OPALINE_COST_BUDGET (as the service's)."""
+    return setting("cost_budget") if cost_budget is None else cost_budget
+
+
+def prepare_locally(request: RenderRequest, cost_budget: int | None = None) -> Prepared:
+    """A request prepared in this process (checked against the limits and the budget): no
+    GL, so a refusal costs no context."""
+    return prepare(request, local_context(budget_of(cost_budget)))
+
+
 class LocalRenderer:
     """Renders requests on a private headless context."""
 
@@ -39,7 +50,7 @@ class LocalRenderer:
 
     @property
     def budget(self) -> int:
-        return setting("cost_budget") if self.cost_budget is None else self.cost_budget
+        return budget_of(self.cost_budget)
 
     def __enter__(self) -> LocalRenderer:
         return self
@@ -51,7 +62,7 @@ class LocalRenderer:
         self.renderer.release()
 
     def prepare(self, request: RenderRequest) -> Prepared:
-        return prepare(request, local_context(self.budget))
+        return prepare_locally(request, self.cost_budget)
 
     def produce(self, prepared: Prepared) -> bytes:
         return produce(prepared, self.renderer)

@@ -17,11 +17,12 @@ import numpy as np
 from pydantic import ValidationError
 
 from opaline.local.api import RequestError, renderer
-from opaline.local.pipeline import LocalRenderer
+from opaline.local.pipeline import LocalRenderer, budget_of, prepare_locally
 from opaline.model.params import describe_errors
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
 from opaline.output.animation import encode
 from opaline.output.encode import quantise
+from opaline.pipeline.prepare import Prepared
 from opaline.settings import BackendName
 
 Progress = Callable[[int, int], None]
@@ -43,11 +44,19 @@ def render_turntable(request: TurntableRequest | Mapping[str, Any], *,
     return turntable_bytes(renderer(backend), as_turntable(request), progress)
 
 
+def prepare_turntable(request: TurntableRequest, cost_budget: int | None = None) -> Prepared:
+    """The frames' common job, checked against the limits and the budget over all frames;
+    no GL, so the CLI checks before it opens a context."""
+    prepared = prepare_locally(request.still(), cost_budget)
+    check_turntable_cost(prepared.job, request.frames, budget_of(cost_budget))
+    return prepared
+
+
 def turntable_bytes(local: LocalRenderer, request: TurntableRequest,
-                    progress: Progress | None = None) -> bytes:
-    prepared = local.prepare(request.still())
+                    progress: Progress | None = None, prepared: Prepared | None = None) -> bytes:
+    """The animation; ``prepared``: ``prepare_turntable``'s answer, if already had."""
+    prepared = prepared or prepare_turntable(request, local.cost_budget)
     preset, job = prepared.preset, prepared.job
-    check_turntable_cost(job, request.frames, local.budget)
     frames: list[np.ndarray] = []
     jobs = frame_jobs(job, preset, request.frames)
     for index, frame_job in enumerate(jobs, 1):

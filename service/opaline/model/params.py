@@ -9,7 +9,8 @@ range is written once.
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from types import NoneType, UnionType
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 from pydantic import (
     BaseModel,
@@ -175,3 +176,16 @@ def describe_errors(
 ) -> list[str]:
     """One line per problem (``opaline.model.messages``), for a request unless told otherwise."""
     return messages.describe_errors(exc, model)
+
+
+def _is_tuple(annotation: Any) -> bool:
+    """Whether a field's type is a tuple, alone or beside None."""
+    if get_origin(annotation) in (Union, UnionType):
+        return any(_is_tuple(a) for a in get_args(annotation) if a is not NoneType)
+    return get_origin(annotation) is tuple
+
+
+def tuple_fields(model: type[BaseModel]) -> frozenset[str]:
+    """The fields that take a tuple (albedo, metal_f0 ...): a query string may repeat them,
+    and a query or ``--set`` value of theirs is split at commas."""
+    return frozenset(name for name, f in model.model_fields.items() if _is_tuple(f.annotation))

@@ -26,8 +26,9 @@ from starlette.responses import Response
 from starlette.routing import Match, Mount
 from starlette.types import ASGIApp, Receive, Scope, Send
 
+from opaline.model.params import tuple_fields
 from opaline.server.errors import problem
-from opaline.server.queries import MdfQuery, RenderQuery, tuple_fields
+from opaline.server.queries import MdfQuery, RenderQuery
 
 REPEATABLE = tuple_fields(RenderQuery) | tuple_fields(MdfQuery)
 PROBED = ("GET", "POST", "PUT", "PATCH", "DELETE")

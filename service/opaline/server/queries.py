@@ -8,8 +8,7 @@ each time; every other field is the request model's own.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from types import NoneType, UnionType
-from typing import Any, Literal, TypeVar, Union, get_args, get_origin
+from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, Field, field_validator
 from pydantic_core import from_json
@@ -21,6 +20,7 @@ from opaline.model.params import (
     MaterialFields,
     Pixels,
     RenderRequest,
+    tuple_fields,
     wavelengths_ok,
     wavelengths_schema,
 )
@@ -32,18 +32,6 @@ def _comma_list(value: Any) -> Any:
     if isinstance(value, list) and len(value) == 1 and isinstance(value[0], str):
         value = value[0]
     return value.split(",") if isinstance(value, str) else value
-
-
-def _is_tuple(annotation: Any) -> bool:
-    """Whether a field's type is a tuple, alone or beside None."""
-    if get_origin(annotation) in (Union, UnionType):
-        return any(_is_tuple(a) for a in get_args(annotation) if a is not NoneType)
-    return get_origin(annotation) is tuple
-
-
-def tuple_fields(model: type[BaseModel]) -> frozenset[str]:
-    """The fields a query string may give as repeated parameters (one value each)."""
-    return frozenset(name for name, f in model.model_fields.items() if _is_tuple(f.annotation))
 
 
 class RenderQuery(RenderRequest):

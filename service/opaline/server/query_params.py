@@ -21,7 +21,7 @@ from fastapi import FastAPI, Query, Request
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel, ValidationError
 
-from opaline.server.queries import tuple_fields
+from opaline.model.params import tuple_fields
 
 Model = TypeVar("Model", bound=BaseModel)
 
