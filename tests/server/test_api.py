@@ -354,6 +354,24 @@ def test_bad_choice_and_bad_json_are_422(client):
     assert empty.status_code == 400 and "JSON object is required" in problems(empty)[0]
 
 
+@pytest.mark.parametrize("path", ["/v1/render", "/v1/export/glb", "/v1/turntables"])
+def test_a_body_not_sent_as_json_is_415(client, path):
+    """`curl -d` labels a body a form: refused as such, naming the header to send, where it
+    was read as JSON whatever it was labelled; JSON's own types and no label are read."""
+    body = b'{"preset": "sphere", "frames": 2}' if "turntables" in path else b'{"preset": "sphere"}'
+    for label in ("application/x-www-form-urlencoded", "text/plain; charset=utf-8"):
+        refused = client.post(path, content=body, headers={"content-type": label})
+        assert refused.status_code == 415, refused.text
+        assert refused.json()["error"] == "unsupported_media_type"
+        assert "application/json" in problems(refused)[0]
+    if "turntables" in path:
+        return  # accepted ones would start a turntable: the render route shows the rest
+    for label in ("application/json; charset=utf-8", "application/problem+json", None):
+        headers = {"content-type": label} if label else {}
+        answer = client.post(path, content=body, headers=headers)
+        assert answer.status_code == 200, (label, answer.text)
+
+
 def test_mdf_bad_input_is_422(client):
     """The MDF route checks its own fields: size, format and wavelengths."""
     lines = problems(client.get("/v1/mdf?size=4096&format=png16&wavelengths=200&bogus=1"))

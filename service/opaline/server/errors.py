@@ -98,6 +98,12 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     500: {"model": Problem, "description": "The render failed (details in the server log)."},
 }
 
+# What a route with a JSON body adds (queries.require_json).
+JSON_BODY_RESPONSES: dict[int | str, dict[str, Any]] = {
+    415: {"model": Problem, "description": "The body is labelled as something other than "
+                                           "JSON (send content-type: application/json)."},
+}
+
 # Handlers
 
 

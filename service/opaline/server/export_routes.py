@@ -12,8 +12,8 @@ from opaline.model.params import RenderRequest
 from opaline.model.request import content_key
 from opaline.pipeline.prepare import prepare
 from opaline.server.deps import ServiceDep
-from opaline.server.errors import ERROR_RESPONSES
-from opaline.server.queries import RenderQuery, parse_body, refuse_query
+from opaline.server.errors import ERROR_RESPONSES, JSON_BODY_RESPONSES
+from opaline.server.queries import RenderQuery, json_body, parse_body
 from opaline.server.render_routes import BODY, RENDER_RESPONSES
 from opaline.workers.export_task import GlbTask, GlslTask
 
@@ -35,11 +35,11 @@ async def export_glsl_get(params: Annotated[RenderQuery, Query()], request: Requ
 
 # Parsed strictly, as POST /v1/render's body ({"light_elevation": false} is refused).
 @router.post("/v1/export/glb", tags=["export"], response_class=Response,
-             responses={**ERROR_RESPONSES, 404: RENDER_RESPONSES[404]}, openapi_extra=BODY,
+             responses={**ERROR_RESPONSES, **JSON_BODY_RESPONSES, 404: RENDER_RESPONSES[404]},
+             openapi_extra=BODY,
              summary="The mesh with the material as glTF 2.0 binary (.glb)")
 async def export_glb_post(request: Request, svc: ServiceDep) -> Response:
-    refuse_query(request.query_params)
-    body = parse_body(await request.body(), RenderRequest)
+    body = parse_body(await json_body(request), RenderRequest)
     prepared = prepare(body, svc.context)
     preset, job = prepared.preset, prepared.job
     key = content_key({"glb": job.canonical(), "scene": preset.scene_key()})

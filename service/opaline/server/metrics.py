@@ -27,7 +27,8 @@ REJECT_REASONS = ("invalid", "malformed", "unknown_preset", "not_found", "method
                   "cost", "too_slow", "too_large", "queue_full", "deadline", "unavailable",
                   "cancelled", "forbidden", "rate_limited", "timeout", "render_failed", "error", "limit",
                   "unknown_mesh", "invalid_mesh", "unknown_environment", "unknown_turntable",
-                  "rendering", "busy", "budget_with_tier", "store_unavailable")
+                  "rendering", "busy", "budget_with_tier", "store_unavailable",
+                  "unsupported_media_type")
 # The worker pool's own counters, exported as they stand at scrape time.
 POOL_COUNTERS = {
     "restarts_crash": ("opaline_worker_restarts", "Worker processes replaced, by reason.",

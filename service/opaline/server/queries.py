@@ -12,10 +12,11 @@ from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, Field, field_validator
 from pydantic_core import from_json
+from starlette.requests import Request
 
 from opaline.errors import PublicError
 from opaline.model.material import Unit
-from opaline.model.messages import UNKNOWN_NAMED
+from opaline.model.messages import UNKNOWN_NAMED, shown_name
 from opaline.model.params import (
     MaterialFields,
     Pixels,
@@ -75,6 +76,27 @@ class QueryOnPost(PublicError, ValueError):
     status, reason = 422, "invalid"
 
 
+class NotJson(PublicError, ValueError):
+    """A body sent as something other than JSON (415): ``curl -d`` labels it a form, and
+    a form's fields are not what the service would read from it."""
+
+    status, reason = 415, "unsupported_media_type"
+
+
+def require_json(content_type: str | None) -> None:
+    """``NotJson`` unless the body is labelled ``application/json`` (or a ``+json`` type,
+    parameters such as ``charset`` allowed) or not labelled at all, as FastAPI reads a
+    body."""
+    if content_type is None:
+        return
+    media = content_type.split(";", 1)[0].strip().lower()
+    if media == "application/json" or (media.startswith("application/")
+                                       and media.endswith("+json")):
+        return
+    raise NotJson(f"content-type: the body must be JSON, sent as 'application/json' (it was "
+                  f"{shown_name(content_type)!r}; curl: -H 'content-type: application/json')")
+
+
 def refuse_query(query: Mapping[str, str]) -> None:
     """``QueryOnPost`` naming the query's parameters (as many as an unknown field's
     message names, the rest counted), if it has any."""
@@ -84,6 +106,13 @@ def refuse_query(query: Mapping[str, str]) -> None:
         shown = ", ".join(names[:UNKNOWN_NAMED]) + (f" and {more} more" if more > 0 else "")
         raise QueryOnPost(f"query: a POST reads its fields from the JSON body, not the query "
                           f"string ({shown}): send them in the body")
+
+
+async def json_body(request: Request) -> bytes:
+    """A POST's JSON body, its query string and content type checked first."""
+    refuse_query(request.query_params)
+    require_json(request.headers.get("content-type"))
+    return await request.body()
 
 
 Model = TypeVar("Model", bound=BaseModel)

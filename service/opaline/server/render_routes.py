@@ -33,9 +33,9 @@ from opaline.server.canonical import (
     plot_material,
 )
 from opaline.server.deps import ServiceDep
-from opaline.server.errors import ERROR_RESPONSES, Problem
+from opaline.server.errors import ERROR_RESPONSES, JSON_BODY_RESPONSES, Problem
 from opaline.server.negotiation import Started, negotiated, server_timing
-from opaline.server.queries import MdfQuery, parse_body, refuse_query
+from opaline.server.queries import MdfQuery, json_body, parse_body
 from opaline.server.query_params import documented, query_model
 from opaline.server.service import Service
 from opaline.server.streaming import image_response
@@ -142,11 +142,11 @@ BODY = {"requestBody": {"required": True, "content": {
     "application/json": {"schema": {"$ref": "#/components/schemas/RenderRequest"}}}}}
 
 
-@router.post("/v1/render", tags=["render"], response_class=Response, responses=RENDER_RESPONSES,
+@router.post("/v1/render", tags=["render"], response_class=Response,
+             responses={**RENDER_RESPONSES, **JSON_BODY_RESPONSES},
              summary="Render a preset with material overrides (JSON body)", openapi_extra=BODY)
 async def render_post(started: Started, request: Request, svc: ServiceDep) -> Response:
-    refuse_query(request.query_params)
-    return await answer_render(svc, request, parse_body(await request.body(), RenderRequest),
+    return await answer_render(svc, request, parse_body(await json_body(request), RenderRequest),
                                started)
 
 

@@ -25,6 +25,7 @@ from opaline.server.cache import etag, matches
 from opaline.server.deps import LanesDep, ServiceDep, TurntablesDep
 from opaline.server.errors import (
     ERROR_RESPONSES,
+    JSON_BODY_RESPONSES,
     RETRY_AFTER,
     Busy,
     Problem,
@@ -32,7 +33,7 @@ from opaline.server.errors import (
     UnknownTurntable,
 )
 from opaline.server.negotiation import Started, server_timing
-from opaline.server.queries import refuse_query
+from opaline.server.queries import json_body
 from opaline.server.render_routes import CONDITIONAL, ETAG, RENDER_RESPONSES
 from opaline.server.statestore import Record
 from opaline.server.turntable_jobs import StoredFailure, Turntables, new_job
@@ -83,12 +84,11 @@ BODY = {"requestBody": {"required": True, "content": {
 
 
 @router.post("/v1/turntables", tags=["turntables"], status_code=202, openapi_extra=BODY,
-             responses={**ERROR_RESPONSES, 404: RENDER_404, 429: BUSY},
+             responses={**ERROR_RESPONSES, **JSON_BODY_RESPONSES, 404: RENDER_404, 429: BUSY},
              summary="Start a turntable: N frames around the object, then WebP, GIF or MP4")
 async def turntable_post(request: Request, response: Response, svc: ServiceDep,
                          found: TurntablesDep, shared: LanesDep) -> TurntableStatus:
-    refuse_query(request.query_params)
-    raw = await request.body()
+    raw = await json_body(request)
     planned = plan(svc, raw)
     body, _, key = planned
     record = await found.read(key)
