@@ -195,6 +195,20 @@ def test_a_mesh_uploaded_through_the_proxy_renders_on_every_replica(stateful):
           f"{[routed.count(u) for u in sorted(set(routed))]} via {sorted(set(routed))}")
 
 
+def test_an_uploaded_mesh_is_described_by_every_replica(stateful):
+    """The 201's Location answers the same summary whichever replica takes the GET (one
+    that never saw the upload checks the file it fetches from the store)."""
+    replicas, proxy, client = stateful
+    upload = client.post("/v1/meshes", content=mesh_bytes("obj"))
+    assert upload.status_code == 201, upload.text
+    path = upload.headers["location"]
+    answers = [client.get(path) for _ in range(4)]  # not cached: round robin
+    assert [a.status_code for a in answers] == [200] * 4, [a.text for a in answers]
+    assert all(a.json() == upload.json() for a in answers)
+    routed = {upstream(line) for line in log_lines(proxy, path, count=4)}
+    assert routed == {r.base.removeprefix("http://") for r in replicas}, routed
+
+
 def poll_until_done(clients: list[httpx.Client], path: str) -> list[dict]:
     """GET ``path`` from each client in turn until the turntable is no longer running."""
     seen: list[dict] = []

@@ -30,6 +30,23 @@ def client(backend, tmp_path_factory):
 
 
 @pytest.mark.gl
+def test_the_upload_names_its_summary_url(client):
+    """The 201's Location answers the upload's summary; a mesh of the folder has one too,
+    under its file name; an id never stored, or a name the folder lacks, is 404."""
+    answer = client.post("/v1/meshes", content=mesh_bytes("obj"))
+    assert answer.status_code == 201, answer.text
+    assert answer.headers["location"] == f"/v1/meshes/{answer.json()['id']}"
+    described = client.get(answer.headers["location"])
+    assert described.status_code == 200 and described.json() == answer.json()
+    shelf = client.get("/v1/meshes/shelf.ply")
+    assert shelf.status_code == 200, shelf.text
+    assert shelf.json()["id"] == "shelf.ply" and shelf.json()["format"] == "ply"
+    for name in ("0" * 32, "nope.ply", ".hidden"):
+        missing = client.get(f"/v1/meshes/{name}")
+        assert missing.status_code == 404 and missing.json()["error"] == "unknown_mesh", name
+
+
+@pytest.mark.gl
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_upload_then_render_each_format(client, fmt):
     data = mesh_bytes(fmt)

@@ -25,6 +25,7 @@ from pathlib import Path
 
 from opaline import scratch
 from opaline.errors import PublicError
+from opaline.lru import BudgetLRU
 from opaline.model.meshes import file_digest, mesh_preset
 from opaline.model.presets import Preset
 from opaline.model.scene_fields import SceneFields
@@ -34,6 +35,7 @@ from opaline.settings import Settings
 MESH_ID = re.compile(r"^[0-9a-f]{32}$")
 SUFFIX = ".mesh"  # the format is in the bytes; the worker sniffs it
 TOUCH_PAUSE_S = 5.0
+SUMMARIES_KEPT = 1024
 
 
 class UnknownMesh(PublicError, KeyError):
@@ -86,6 +88,8 @@ class MeshStore:
         self._folder_digests: dict[tuple[str, int, int], str] = {}
         self.evictions = 0
         self._touch_after = 0.0
+        # What the check answered of each (JSON, ~200 bytes), for GET /v1/meshes/{id}.
+        self.summaries: BudgetLRU[str, bytes] = BudgetLRU(SUMMARIES_KEPT, SUMMARIES_KEPT * 1024)
         # What an earlier run left, oldest first, so restarts keep the LRU order.
         found = sorted(self.root.glob("*" + SUFFIX), key=lambda p: p.stat().st_mtime_ns)
         for path in found:
@@ -159,7 +163,7 @@ class MeshStore:
             path = Path(self.folder) / name
             try:
                 found = path.is_file()
-            except OSError:  # a name no file can have (over the file system's 255 bytes)
+            except (OSError, ValueError):  # a name no file can have (over 255 bytes, a NUL)
                 found = False
             if found:
                 return path, self._folder_digest(path)
