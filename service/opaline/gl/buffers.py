@@ -128,6 +128,10 @@ class SceneGPU:
             self.projection = (*origin, scale)
         self.vbo = ctx.buffer(mesh.interleaved().astype("f4").tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype("u4").tobytes())
+        # A sphere's v runs pole to pole: tiled, a pole's coarse mip level (its u squeezed
+        # to a point) and its edge texels mixed in the other pole's rows, and a graded
+        # field's thin top showed a dot of the thick bottom's colour.
+        wraps_v = preset.geometry.kind != "sphere"
         self.normal_map = None
         if normal_map is not None:
             height, width = normal_map.shape[:2]
@@ -136,9 +140,9 @@ class SceneGPU:
             self.normal_map = ctx.texture((width, height), 3, data.tobytes(), dtype="f4")
             self.normal_map.build_mipmaps()
             self.normal_map.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-            self.normal_map.repeat_x = self.normal_map.repeat_y = True
-        self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset))
-        self.weight_map = physical.thickness_texture(ctx, build_weight(preset))
+            self.normal_map.repeat_x, self.normal_map.repeat_y = True, wraps_v
+        self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset), wraps_v)
+        self.weight_map = physical.thickness_texture(ctx, build_weight(preset), wraps_v)
         self.culling = Culling(mesh.positions, mesh.indices)
         # Mipmaps add a third to a texture.
         self.nbytes = self.vbo.size + self.ibo.size + sum(

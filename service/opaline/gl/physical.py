@@ -9,10 +9,10 @@ import moderngl
 import numpy as np
 
 
-def thickness_texture(ctx: moderngl.Context,
-                      field: np.ndarray | None) -> moderngl.Texture | None:
-    """A [0, 1] field over uv (a film's thickness or weight) as a tiling, mipmapped
-    one-channel float texture."""
+def thickness_texture(ctx: moderngl.Context, field: np.ndarray | None,
+                      wraps_v: bool = True) -> moderngl.Texture | None:
+    """A [0, 1] field over uv (a film's thickness or weight) as a mipmapped one-channel
+    float texture that tiles in u, and in v where the surface's v wraps (``wraps_v``)."""
     if field is None:
         return None
     height, width = field.shape
@@ -21,7 +21,7 @@ def thickness_texture(ctx: moderngl.Context,
     texture = ctx.texture((width, height), 1, data.tobytes(), dtype="f4")
     texture.build_mipmaps()
     texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-    texture.repeat_x = texture.repeat_y = True
+    texture.repeat_x, texture.repeat_y = True, wraps_v
     return texture
 
 
