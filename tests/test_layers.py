@@ -18,6 +18,7 @@ RANKS = {
     "opaline": 0,
     "opaline.settings": 0, "opaline.setting_defaults": 0, "opaline.service_settings": 0,
     "opaline.resources": 0, "opaline.lru": 0, "opaline.errors": 0, "opaline.scratch": 0,
+    "opaline.digests": 0,
     "opaline.scene": 1,
     "opaline.model": 2,
     "opaline.gl": 3, "opaline.output": 3,

@@ -209,7 +209,7 @@ def test_a_map_read_takes_one_level_with_trilinear_odds(renderer, tmp_path, lod)
     the mix: it fails on the read between the two.)"""
     import cv2
 
-    height, width = 32, 64
+    height, width = 64, 128  # the smallest a file is read at (environment_files.fit)
     rows, cols = np.indices((height, width))
     checker = ((rows + cols) % 2).astype(np.float32)
     cv2.imwrite(str(tmp_path / "checker.hdr"), np.repeat(checker[..., None], 3, axis=2))

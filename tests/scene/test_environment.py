@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from opaline.model.params import RenderRequest
-from opaline.scene import environments
+from opaline.scene import environment_files, environments
 from opaline.scene.mediancut import directions, median_cut
 
 COUNTS = (1, 4, 16, 64)
@@ -102,10 +102,10 @@ def test_files_that_cannot_be_read_are_refused_by_name_without_the_folder(tmp_pa
     with exr.File(header, {"Y": np.ones((4, 8), dtype=np.float32)}) as file:
         file.write(str(tmp_path / "grey.exr"))
     (tmp_path / "empty.exr").write_bytes(b"")
-    for name, why in (("huge.hdr", "OpenCV refused it"), ("grey.exr", "no R, G and B channels"),
+    for name, why in (("huge.hdr", "scale it down"), ("grey.exr", "no R, G and B channels"),
                       ("empty.exr", "cannot read")):
         with pytest.raises(environments.EnvironmentMapError) as caught:
-            environments.read_file(tmp_path / name)
+            environment_files.read_file(tmp_path / name)
         message = str(caught.value)
         assert message.startswith(f"environment {name}: ") and why in message, message
         assert str(tmp_path) not in message
@@ -189,12 +189,12 @@ def test_a_users_broken_texels_are_sanitised_and_logged(tmp_path, caplog):
 
     pytest.importorskip("OpenEXR")
     written = ENVIRONMENT_MAPS["nan-inf"][1]()
-    with caplog.at_level("WARNING", logger="opaline.scene.environments"):
-        radiance = environments.read_file(tmp_path / write_environment(tmp_path, "nan-inf"))
+    with caplog.at_level("WARNING", logger="opaline.scene.environment_files"):
+        radiance = environment_files.read_file(tmp_path / write_environment(tmp_path, "nan-inf"))
     broken = ~np.isfinite(written) | (written < 0)
     assert np.all(radiance[broken] == 0.0)
-    huge = ~broken & (written > environments.MAX_RADIANCE)
-    assert huge.any() and np.all(radiance[huge] == environments.MAX_RADIANCE)
+    huge = ~broken & (written > environment_files.MAX_RADIANCE)
+    assert huge.any() and np.all(radiance[huge] == environment_files.MAX_RADIANCE)
     rest = ~broken & ~huge
     assert np.array_equal(radiance[rest], written[rest])
     assert f"{int(broken.sum())} non-finite or negative values set to 0" in caplog.text
@@ -205,7 +205,7 @@ def test_a_clean_file_reads_unchanged_and_silently(tmp_path, caplog):
     from environment_cases import ENVIRONMENT_MAPS, write_environment
 
     pytest.importorskip("OpenEXR")
-    with caplog.at_level("WARNING", logger="opaline.scene.environments"):
-        radiance = environments.read_file(tmp_path / write_environment(tmp_path, "range-1e5"))
+    with caplog.at_level("WARNING", logger="opaline.scene.environment_files"):
+        radiance = environment_files.read_file(tmp_path / write_environment(tmp_path, "range-1e5"))
     assert np.array_equal(radiance, ENVIRONMENT_MAPS["range-1e5"][1]())
     assert caplog.text == ""

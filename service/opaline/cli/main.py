@@ -29,7 +29,7 @@ from opaline.model.presets import PresetError, UnknownPreset, all_presets
 from opaline.model.request import CostError, resolve
 from opaline.pipeline.limits import LimitError
 from opaline.resources import PRESETS_ENV, presets_dir
-from opaline.scene.environments import EnvironmentMapError
+from opaline.scene.environment_files import EnvironmentMapError
 from opaline.scene.meshfile import MeshError
 from opaline.settings import SettingsError
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from opaline.model import irradiance
 from opaline.scene.bright import split_bright
-from opaline.scene.environments import resolve_map
+from opaline.scene.environments import map_identity, resolve_map
 
 KEPT = 4
 
@@ -35,16 +35,17 @@ class EnvironmentMaps:
     def __init__(self, ctx: moderngl.Context, environments_dir: Path | None) -> None:
         self.ctx = ctx
         self.environments_dir = environments_dir
-        self._maps: OrderedDict[str, EnvironmentMap] = OrderedDict()
+        self._maps: OrderedDict[tuple[object, ...], EnvironmentMap] = OrderedDict()
 
     def get(self, name: str) -> EnvironmentMap:
-        found = self._maps.get(name)
+        key = map_identity(name, self.environments_dir)  # a file replaced is read again
+        found = self._maps.get(key)
         if found is None:
             found = self._upload(name)
-            self._maps[name] = found
+            self._maps[key] = found
             while len(self._maps) > KEPT:
                 self._maps.popitem(last=False)[1].texture.release()
-        self._maps.move_to_end(name)
+        self._maps.move_to_end(key)
         return found
 
     def _upload(self, name: str) -> EnvironmentMap:

@@ -4,10 +4,10 @@ defaults drawing the user's mesh (geometry kind ``file``, loaded in the worker b
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 from typing import Any
 
+from opaline.digests import file_digest
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
 from opaline.scene.environments import MESH_ENVIRONMENT
@@ -16,15 +16,6 @@ from opaline.scene.gltf_film import film_texture_names
 MESH_KIND = "file"
 # The camera a mesh gets (azimuth, elevation in degrees): three-quarter view from above.
 MESH_VIEW = (60.0, 20.0)
-
-
-def file_digest(path: Path) -> str:
-    """Content hash of a mesh file (part of the scene key: an edited file draws anew)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for chunk in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()[:32]
 
 
 def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max_triangles: int) -> Preset:

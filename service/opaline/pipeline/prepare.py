@@ -19,7 +19,8 @@ from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, resolve
 from opaline.pipeline.canonical import canonical_query, canonical_url
 from opaline.pipeline.limits import Limits, check_limits
-from opaline.scene.environments import EnvironmentMapError, check_name
+from opaline.scene.environment_files import EnvironmentMapError, file_digest
+from opaline.scene.environments import check_name
 
 # How a request's mesh becomes a preset: a file on this machine (CLI, Python, batches) or
 # an upload's id (HTTP). Given the request and the preset it names.
@@ -53,6 +54,8 @@ class Prepared:
     # digest): what the workers' cost model was calibrated on, and its name a metric's
     # label, from a set that uploads cannot grow.
     named: Preset
+    # The scene's part of the key: the preset's, and an environment file's content.
+    scene_key: str
 
     def query(self) -> dict[str, str]:
         """The canonical GET query's fields, spelled, without ``rev``."""
@@ -63,27 +66,32 @@ class Prepared:
 
     def with_job(self, job: Job) -> Prepared:
         """The same scene drawing another job (a turntable's frame), keyed anew."""
-        return replace(self, job=job, key=job.cache_key(self.preset.scene_key()))
+        return replace(self, job=job, key=job.cache_key(self.scene_key))
 
 
-def scene(request: RenderRequest, named: Preset, context: Context) -> Preset:
-    """The preset a request draws (``named``, or its mesh's if it names one), after checking
-    that its environment exists: names are the built-ins plus the files of a folder, which
-    the schema cannot list, so an unknown one is refused like an unknown preset."""
+def scene(request: RenderRequest, named: Preset, context: Context) -> tuple[Preset, str]:
+    """The preset a request draws (``named``, or its mesh's if it names one) and its scene
+    key, after checking that its environment exists: names are the built-ins plus the
+    files of a folder, which the schema cannot list, so an unknown one is refused like an
+    unknown preset. A file's content is part of the key: replaced under its name, it
+    draws anew (and its canonical URL's rev changes) where the old image was answered."""
     preset = named
     if request.mesh is not None:
         preset = context.meshes(request, named)
+    key = preset.scene_key()
     if request.environment is not None and context.check_environments:
         try:
-            check_name(request.environment, context.environments_dir)
+            path = check_name(request.environment, context.environments_dir)
         except EnvironmentMapError as exc:
             raise UnknownEnvironment(str(exc)) from None
-    return preset
+        if path is not None:
+            key = f"{key}+{file_digest(path)}"
+    return preset, key
 
 
 def prepare(request: RenderRequest, context: Context) -> Prepared:
     named = get_preset(request.preset)
-    preset = scene(request, named, context)
+    preset, scene_key = scene(request, named, context)
     job = resolve(request, preset)
     check_limits(job, context.limits)
-    return Prepared(request, preset, job, job.cache_key(preset.scene_key()), named)
+    return Prepared(request, preset, job, job.cache_key(scene_key), named, scene_key)

@@ -10,23 +10,22 @@ nothing to ship and are the same on every machine:
 * ``sky``: a clear sky (brighter at the horizon, deeper blue at the zenith),
   a sun 35° up, and a dim ground.
 
-Files (Radiance ``.hdr`` through OpenCV's reader, OpenEXR ``.exr`` through
-the OpenEXR package) are read from
-the environments folder of the settings, in the worker processes; both
-libraries are imported only when a file is asked for. A file's NaN, infinite and
-negative texels become 0 and its radiance is clamped to ``MAX_RADIANCE`` (logged):
-a photographed or rendered map with a few broken pixels still lights a scene, and
-nothing it holds can reach a pixel as NaN or Inf.
+Files (Radiance ``.hdr``, OpenEXR ``.exr``) are read from the environments folder of
+the settings, in the worker processes, by ``environment_files``: bounded before they
+are decoded, cleaned (a photographed or rendered map with a few broken pixels still
+lights a scene, and nothing it holds can reach a pixel as NaN or Inf), fitted to the
+sizes lighting uses, and known by their content. ``map_identity`` is what a cache of
+maps is keyed by: a file replaced under its name is read again.
 """
 
 from __future__ import annotations
 
-import logging
 from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
 
+from opaline.scene.environment_files import EnvironmentMapError, fit, read_file
 from opaline.scene.mediancut import directions, median_cut
 from opaline.scene.studio import neutral, studio
 
@@ -41,17 +40,6 @@ MESH_ENVIRONMENT = "sky"
 SIZE = (128, 256)  # rows, columns: 1.4° per texel, enough for the sun's disc
 SUFFIXES = (".hdr", ".exr")
 CACHED = 8
-# The most radiance a file's texel keeps. Far above any real scene in relative units (a
-# sun is ~1e5 times its sky); below it every range at its end (environment_intensity
-# 1000, ks 100, the three-lobe mixture's weight 3, exposure 1000: 3e8 per unit radiance)
-# keeps fp32 finite through the ACES tone map, whose x² overflows above 1.8e19.
-MAX_RADIANCE = 1e10
-
-log = logging.getLogger(__name__)
-
-
-class EnvironmentMapError(ValueError):
-    """An environment that is not known or cannot be read; the message says which."""
 
 
 def sky() -> np.ndarray:
@@ -70,62 +58,6 @@ def sky() -> np.ndarray:
     return lit.astype(np.float32)
 
 
-def read_file(path: Path) -> np.ndarray:
-    """Linear RGB float32 (H, W, 3) from a Radiance .hdr or an OpenEXR file."""
-    suffix = path.suffix.lower()
-    try:
-        if suffix == ".exr":
-            import OpenEXR
-
-            with OpenEXR.File(str(path)) as exr:
-                channels = exr.channels()
-                if "RGB" in channels:
-                    image = np.asarray(channels["RGB"].pixels, dtype=np.float32)
-                elif all(c in channels for c in "RGB"):
-                    image = np.stack([np.asarray(channels[c].pixels, dtype=np.float32)
-                                      for c in "RGB"], -1)
-                else:
-                    raise ValueError(f"no R, G and B channels (it has {', '.join(channels)})")
-        else:
-            image = _read_radiance(path)
-    except ImportError as exc:
-        raise EnvironmentMapError(f"environment {path.name}: reading {suffix} files needs "
-                                  f"{exc.name}, a dependency of opaline: reinstall it") from None
-    except (OSError, ValueError, KeyError, RuntimeError) as exc:
-        # The folder is the server's business: the message names the file, not its path.
-        reason = str(exc).replace(str(path), path.name)
-        raise EnvironmentMapError(f"environment {path.name}: cannot read: {reason}") from None
-    if image.ndim != 3 or image.shape[2] < 3:
-        raise EnvironmentMapError(f"environment {path.name}: expected finite RGB, got "
-                                f"shape {image.shape}")
-    return sanitised(path.name, image[..., :3])
-
-
-def _read_radiance(path: Path) -> np.ndarray:
-    import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
-
-    try:
-        decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
-        raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
-    if decoded is None:
-        raise ValueError("not a Radiance .hdr image")
-    image: np.ndarray = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
-    return image
-
-
-def sanitised(name: str, radiance: np.ndarray) -> np.ndarray:
-    """NaN, ±Inf and negative texels as 0 (a broken pixel is no light: an Inf taken as the
-    maximum would put a sun where none is), the rest clamped to ``MAX_RADIANCE``."""
-    broken = ~np.isfinite(radiance) | (radiance < 0.0)
-    bright = ~broken & (radiance > MAX_RADIANCE)
-    if broken.any() or bright.any():
-        log.warning("environment %s: %d non-finite or negative values set to 0, %d above "
-                    "%g clamped", name, int(broken.sum()), int(bright.sum()), MAX_RADIANCE)
-    clean: np.ndarray = np.where(broken, 0.0, np.minimum(radiance, MAX_RADIANCE))
-    return clean.astype(np.float32)
-
-
 def check_name(name: str, folder: Path | None) -> Path | None:
     """The file ``name`` means (None for a built-in one), without reading it: the HTTP
     process checks names, workers read files."""
@@ -139,24 +71,33 @@ def check_name(name: str, folder: Path | None) -> Path | None:
                             "sky, none, or an .hdr/.exr file of the environments folder")
 
 
+def map_identity(name: str, folder: Path | None) -> tuple[object, ...]:
+    """What a cache of maps is keyed by: the name, and for a file its size and time."""
+    path = check_name(name, folder)
+    if path is None:
+        return (name,)
+    stat = path.stat()
+    return (name, str(folder), stat.st_size, stat.st_mtime_ns)
+
+
 def resolve_map(name: str, folder: Path | None) -> np.ndarray:
     path = check_name(name, folder)
     if path is not None:
-        return read_file(path)
+        return fit(read_file(path))
     if name == "studio":
         return studio()
     return neutral() if name == "neutral" else sky()
 
 
-# (name, count, folder) -> (directions, irradiances)
-_lights: OrderedDict[tuple[str, int, str], tuple[np.ndarray, np.ndarray]] = OrderedDict()
+# (map_identity, count) -> (directions, irradiances)
+_lights: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray]] = OrderedDict()
 
 
 def environment_lights(name: str, count: int, rotation_deg: float = 0.0, intensity: float = 1.0,
                        folder: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(K, 3) directions toward the lights and (K, 3) irradiances, rotated about +y by
     ``rotation_deg`` (the environment turns, the object stays) and scaled by ``intensity``."""
-    key = (name, count, str(folder))
+    key = (*map_identity(name, folder), count)
     if key not in _lights:
         _lights[key] = median_cut(resolve_map(name, folder), count)
         while len(_lights) > CACHED:

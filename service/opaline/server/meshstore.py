@@ -24,9 +24,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 from opaline import scratch
+from opaline.digests import file_digest
 from opaline.errors import PublicError
 from opaline.lru import BudgetLRU
-from opaline.model.meshes import file_digest, mesh_preset
+from opaline.model.meshes import mesh_preset
 from opaline.model.presets import Preset
 from opaline.model.scene_fields import SceneFields
 from opaline.server.statestore import StateStore, StoreUnavailable

@@ -116,7 +116,7 @@ def main(conn: Connection, factory: Any, parent_pid: int, lp_threads: int | None
 def serve(conn: Connection, renderer: Any, cancel: Any) -> None:
     from opaline.gl.buffers import Cancelled
     from opaline.gl.shaders import ShaderError
-    from opaline.scene.environments import EnvironmentMapError
+    from opaline.scene.environment_files import EnvironmentMapError
     from opaline.scene.meshfile import MeshError
 
     def should_stop() -> bool:
