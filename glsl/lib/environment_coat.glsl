@@ -17,7 +17,7 @@
 #endif
 
 vec3 environment_coat(Material mat, Environment env, realmat3 frame, vec3 v) {
-    vec3 vl = vec3(transpose(frame) * real3(v));
+    vec3 vl = env_view_above(vec3(transpose(frame) * real3(v)));
     // Its own shift of the sequence: drawn with the material's, the coat's directions
     // would follow the base's sample for sample.
     vec3 shift = env_pixel_shift().zxy;

@@ -34,6 +34,19 @@ struct Environment {
 #endif
 };
 
+// The view in the shading frame, at least ENV_MIN_NV above the shading plane. A normal
+// interpolated across a silhouette's triangle can face away from the view though the
+// triangle faces it: every sample of a glossy lobe then reflected under the surface, and
+// the rim of a soap bubble had black pixels among neighbours reflecting the horizon.
+#define ENV_MIN_NV 0.02
+vec3 env_view_above(vec3 vl) {
+    if (vl.z >= ENV_MIN_NV) {
+        return vl;
+    }
+    vec2 across = dot(vl.xy, vl.xy) > 1e-12 ? normalize(vl.xy) : vec2(1.0, 0.0);
+    return vec3(across * sqrt(1.0 - ENV_MIN_NV * ENV_MIN_NV), ENV_MIN_NV);
+}
+
 // Into the map's own frame (the environment turns, the object stays).
 vec3 env_to_map(Environment env, vec3 d) {
     float c = env.turn.x;
@@ -240,7 +253,7 @@ vec3 environment_specular(Material mat, Environment env, realmat3 frame, vec3 v,
 #ifdef ENV_GRATING_ORDERS
     return environment_grating(mat, env, frame, v);
 #else
-    vec3 vl = vec3(transpose(frame) * real3(v));
+    vec3 vl = env_view_above(vec3(transpose(frame) * real3(v)));
     vec3 shift = env_pixel_shift();
 #ifdef FILM_PER_PIXEL
     vec2 film_at = vec2(0.0);  // Σ luminance·v·h, Σ luminance of the samples' light
