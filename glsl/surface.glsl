@@ -1,4 +1,4 @@
-//! defines: MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS FILM_GAUSSIANS COAT FILM_WEIGHT_MAP TRANSFER_BT709 ENV_QUAD_MEAN COAT_SAMPLES COAT_QUAD_MEAN
+//! defines: TWO_SIDED MDF_ASHIKHMIN MDF_MULTIPEAK WAVELENGTHS DIFFUSE FRESNEL NORMAL_MAP TANGENT_CONCENTRIC OBJECT_PROJECTION LIGHT_COUNT AA_ANALYTIC IRIDESCENCE_THIN_FILM IRIDESCENCE_GRATING GRATING_ORDERS BESSEL_TERMS THICKNESS_MAP TRANSMISSION WAVES DISPLAY TONEMAP_REINHARD TONEMAP_ACES ENVIRONMENT_MAP ENV_SAMPLES ENV_BRUTE ENV_ENVELOPE ENV_RGB_LOBES ENV_GRATING_ORDERS ENV_GRATING_READS ENV_BACKDROP FILM_PER_PIXEL TONEMAP_NEUTRAL SUBSTRATE_CONDUCTOR FILM_WEIGHT STACK_PAIRS FILM_GAUSSIANS COAT FILM_WEIGHT_MAP TRANSFER_BT709 ENV_QUAD_MEAN COAT_SAMPLES COAT_QUAD_MEAN
 // A lit mesh with the iridescent material. Outputs linear radiance with alpha 1
 // (coverage), accumulated over jittered samples by the renderer.
 
@@ -150,6 +150,20 @@ void main() {
     // A zero normal in the map keeps the geometric one.
     if (dot(mapped, mapped) > 1e-12) {
         n = shading_frame(n, t) * normalize(mapped);
+    }
+#endif
+#ifdef TWO_SIDED
+    // Seen from behind (the side its normals do not face), a surface is shaded as its
+    // front, mirrored: the back of an open sheet was black under every light. The face's
+    // own normal from the position's screen derivatives faces the eye; a shading normal
+    // on its other side is flipped. (A normal that only leans past the silhouette stays:
+    // it is on the face's side.)
+    vec3 face = cross(dFdx(v_world), dFdy(v_world));
+    if (dot(face, u_eye - v_world) < 0.0) {
+        face = -face;
+    }
+    if (dot(n, face) < 0.0) {
+        n = -n;
     }
 #endif
     mat3 frame = shading_frame(n, t);

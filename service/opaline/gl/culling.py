@@ -22,6 +22,8 @@ class Culling:
     """What one scene's mesh allows: decided once per mesh, then per view from 8 corners."""
 
     def __init__(self, positions: np.ndarray, indices: np.ndarray) -> None:
+        self.positions, self.indices = positions, indices
+        self._planes: tuple[np.ndarray, np.ndarray] | None = None  # (normals, n·p), lazily
         self.sign = orientation(positions, indices)
         closed = self.sign != 0
         self.corners = np.zeros((8, 3))
@@ -49,3 +51,17 @@ class Culling:
             return None
         # A mirroring model matrix turns counter-clockwise triangles clockwise on screen.
         return "ccw" if self.sign * determinant > 0.0 else "cw"
+
+    def shows_back(self, model: np.ndarray, eye: tuple[float, ...]) -> bool:
+        """Whether the eye sees some triangle from behind (the side its winding, and so its
+        vertex normals, do not face); asked of the built-in meshes. The sign of n·(eye − p)
+        is kept by any affine model matrix (normals turn by its inverse transpose), so the
+        test runs in object space, on each triangle's plane, kept from the first time."""
+        if self._planes is None:
+            corners = self.positions.astype(np.float64)[self.indices.reshape(-1, 3)]
+            normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+            self._planes = (normals, np.einsum("ij,ij->i", normals, corners[:, 0]))
+        normals, offsets = self._planes
+        eye_object = (np.append(np.asarray(eye, dtype=np.float64), 1.0)
+                      @ np.linalg.inv(np.asarray(model, dtype=np.float64)))[:3]
+        return bool(np.any(normals @ eye_object < offsets))

@@ -32,6 +32,7 @@ from opaline.gl.resources import Resources
 from opaline.model import color_space
 from opaline.model.camera import fit_matrix, model_matrix, view_camera, view_projection
 from opaline.model.environment_light import reads_map
+from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.model.spectrum import wavelength_shift
@@ -97,17 +98,23 @@ class SurfacePass:
              should_stop: Callable[[], bool] | None = None) -> None:
         scene = self.resources.scene(preset)
         where = place(job, preset, scene, targets.size)
-        program = self._program(job, preset, scene, plan, where)
+        front_face = scene.culling.front_face(where.model, where.view_proj)
+        # Backs are shaded as fronts where one can be seen: not where culled, and on a
+        # built-in mesh only if this view sees one (a user's mesh not culled may).
+        two_sided = front_face is None and (
+            is_mesh(preset) or scene.culling.shows_back(where.model, where.eye))
+        program = self._program(job, preset, scene, plan, where, two_sided)
         background = self.backgrounds.prepare(self.resources.programs, job, where.view_proj,
                                               targets.size)
-        front_face = scene.culling.front_face(where.model, where.view_proj)
         self._samples(job, preset, targets, plan, program, scene.vao(self.resources.ctx, program),
                       background, front_face, should_stop)
 
     def _program(self, job: Job, preset: Preset, scene: SceneGPU, plan: DrawPlan,
-                 where: Placement) -> moderngl.Program:
+                 where: Placement, two_sided: bool) -> moderngl.Program:
         """The surface variant for this job and plan, its uniforms set and textures bound."""
         defines = material_program.surface_defines(job, preset, plan.brute)
+        if two_sided:
+            defines["TWO_SIDED"] = True
         if scene.projection is not None:
             defines["OBJECT_PROJECTION"] = True
         if plan.display:
