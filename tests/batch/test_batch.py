@@ -211,6 +211,28 @@ def test_missing_input_fails_alone(tmp_path, backend):
     assert "no such file" in items["nope"]["error"] and items["disc-a"]["status"] == "rendered"
 
 
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_an_output_that_cannot_be_written_fails_alone(tmp_path, backend, jobs):
+    """A folder where one image goes: that item fails in the summary, the others render.
+    Before, the batch stopped at it with no summary (and with --jobs 2 rendered nothing)."""
+    folder = make_folder(tmp_path / "m", {name: MIXED["disc-a.toml"]
+                                          for name in ("ball.toml", "disc-a.toml", "disc-b.toml")})
+    out = tmp_path / "out"
+    (out / "disc-a.png").mkdir(parents=True)
+    assert run_cli("batch", str(folder), "--out", str(out), "--backend", backend,
+                   "--jobs", jobs) == 1
+    items = by_name(summary_of(out))
+    assert "cannot write" in items["disc-a"]["error"] and "is a directory" in items["disc-a"]["error"]
+    assert items["ball"]["status"] == items["disc-b"]["status"] == "rendered"
+
+
+def test_out_that_is_a_file_is_a_usage_error(tmp_path, capsys):
+    folder = make_folder(tmp_path / "m", {"disc-a.toml": MIXED["disc-a.toml"]})
+    (tmp_path / "taken").write_text("")
+    status, _, err = run_captured(capsys, "batch", str(folder), "--out", str(tmp_path / "taken"))
+    assert status == 2 and "not a folder" in err
+
+
 def test_two_worker_processes_give_the_same_bytes_as_one(tmp_path, backend):
     """--jobs 2 (spawned processes, a context each) renders byte-identical images to --jobs 1."""
     folder = make_folder(tmp_path / "m", {k: v for k, v in MIXED.items() if "bad" not in k})

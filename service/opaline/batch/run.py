@@ -69,6 +69,8 @@ def run_batch(inputs: list[str | Path], options: Options,
     if not items:
         shown = ", ".join(map(str, inputs))
         raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
+    # A folder that cannot be made is the batch's error, not each item's.
+    options.out.mkdir(parents=True, exist_ok=True)
     # Every shard prunes against all items: the others' outputs are not "gone".
     tasks = plan(select(items, options.shard), options.out, force=options.force,
                  context=batch_context(options))
@@ -135,7 +137,12 @@ def finish(task: Task, future: Future[Outcome]) -> None:
     if data is None:
         task.status, task.error = "failed", f"{task.item.source}: {error}"
         return
-    write_result(task, data)
+    try:
+        write_result(task, data)
+    except OSError as exc:  # this item's output cannot be written: the others go on
+        reason = exc.strerror or str(exc)
+        task.status, task.error = "failed", f"{task.item.source}: cannot write {task.output}: {reason}"
+        return
     task.status = "rendered"
 
 

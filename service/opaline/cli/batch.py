@@ -54,10 +54,12 @@ def report_path(report: list[str] | None) -> Path | None:
 
 
 def options_from_args(args: argparse.Namespace) -> Options:
+    """The batch's options, every override and limit checked before any input is read."""
     from opaline.batch.run import Options
     from opaline.batch.shard import ShardError, parse_shard
 
-    """The batch's options, every override and limit checked before any input is read."""
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise CliError(f"--out {args.out}: not a folder (a file of that name is in the way)")
     overrides = overrides_from_args(args)
     if args.server and not args.server.startswith(("http://", "https://")):
         raise CliError(f"--server {args.server!r}: expected an http:// or https:// URL")
