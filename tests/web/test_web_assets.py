@@ -62,6 +62,15 @@ def test_mesh_upload_environment_orbit_and_downloads(page, tmp_path):  # noqa: F
     assert shown_bytes(page) != lit
 
     assert open(downloaded(page, "#dl-image"), "rb").read()[:4] == b"\x89PNG"
+    # Saved under its own format's extension (a WebP was saved as <preset>.png).
+    page.select_option("#in-format", "webp")
+    settle(page)
+    with page.expect_download(timeout=WAIT_MS) as saved:
+        page.click("#dl-image")
+    assert saved.value.suggested_filename.endswith(".webp")
+    assert open(saved.value.path(), "rb").read()[8:12] == b"WEBP"
+    page.select_option("#in-format", "png")
+    settle(page)
     assert "opaline_radiance" in open(downloaded(page, "#dl-glsl")).read()
     assert open(downloaded(page, "#dl-glb"), "rb").read()[:4] == b"glTF"
     page.fill("#tt-frames", "4")

@@ -4,6 +4,7 @@
 import { postJSON, problemOf, request } from './api.js';
 import { $, save, sleep } from './dom.js';
 import { renderQuery } from './queries.js';
+import { imageFileName } from './share.js';
 import { changedFields, setValue, state } from './state.js';
 
 const POLL_MS = 300;
@@ -77,11 +78,12 @@ async function turntable() {
   say('#asset-status', `Turntable: ${status.frames} frames, downloaded`);
 }
 
-// A download: the answer of `ask()` saved as `name`, or its problem shown as `what`'s.
+// A download: the answer of `ask()` saved as `name` (or the name `name(resp)` gives it),
+// or its problem shown as `what`'s.
 async function download(what, ask, name) {
   const resp = await ask();
   if (!resp.ok) { say('#asset-status', `${what}: ${await problem(resp)}`); return; }
-  save(await resp.blob(), name);
+  save(await resp.blob(), typeof name === 'function' ? name(resp) : name);
 }
 
 export function setupAssets() {
@@ -94,7 +96,8 @@ export function setupAssets() {
     event.preventDefault();
     const url = `/v1/render?${renderQuery()}`;
     event.currentTarget.href = url;
-    download('Image', () => request(url), `${state.preset}.png`);
+    download('Image', () => request(url),
+      (resp) => imageFileName(state.preset, resp.headers.get('content-type')));
   });
   $('#dl-glsl').addEventListener('click', () => download('GLSL',
     () => request(`/v1/export/glsl?${renderQuery()}`), 'opaline.glsl'));

@@ -8,6 +8,11 @@ import { changedFields, state, valueOf } from './state.js';
 // The file name each format is saved under (the schema lists formats, not their files).
 const EXTENSIONS = { png: '.png', png16: '.png', npy: '.npy', webp: '.webp',
   'webp-lossless': '.webp', avif: '.avif', jpeg: '.jpg' };
+// The same by the media type an answer has (format=auto's choice is the service's).
+const BY_TYPE = { 'image/png': '.png', 'image/webp': '.webp', 'image/avif': '.avif',
+  'image/jpeg': '.jpg', 'application/x-npy': '.npy' };
+export const imageFileName = (preset, type) =>
+  preset + (BY_TYPE[(type || '').split(';')[0].trim()] || '.png');
 const BOOLEANS = new Map([['true', true], ['1', true], ['false', false], ['0', false]]);
 
 function pageUrl() {
