@@ -31,15 +31,25 @@ if ! "$PY" -c 'import venv, ensurepip' 2>/dev/null; then
   install_debs python3-venv python3-pip
 fi
 
+# The stamp is pyproject.toml's hash and the extras installed with it. Extras already
+# there are enough: scripts/serve after scripts/test (whose extras include the runtime's)
+# must not reinstall, and so need no network, every time the two alternate.
 extras=${OPALINE_EXTRAS:-}
 stamp=".venv/.opaline-stamp"
-want="$(cat pyproject.toml | sha256sum | cut -c1-16)-${extras}"
+hash="$(sha256sum < pyproject.toml | cut -c1-16)"
+have="$(cat "$stamp" 2>/dev/null || true)"
+have_extras=""
+[ "${have%%-*}" = "$hash" ] && have_extras="${have#*-}"
+union="$have_extras"
+for extra in ${extras//,/ }; do
+  case ",$union," in *",$extra,"*) ;; *) union="${union:+$union,}$extra" ;; esac
+done
 if [ ! -x .venv/bin/python ]; then
   "$PY" -m venv .venv
 fi
-if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+if [ "$have" != "$hash-$union" ]; then
   echo "setup: installing Python dependencies into .venv" >&2
   .venv/bin/python -m pip install -q --upgrade pip >&2
-  .venv/bin/python -m pip install -q -e ".${extras:+[$extras]}" >&2
-  echo "$want" > "$stamp"
+  .venv/bin/python -m pip install -q -e ".${union:+[$union]}" >&2
+  echo "$hash-$union" > "$stamp"
 fi

@@ -193,3 +193,38 @@ def test_fresh_venv_install_runs_every_entry_point(wheel, tmp_path):
     thumbs = list((work / "thumbs").rglob("*.png"))
     assert [p.name for p in thumbs] == ["disc.png"], thumbs
     assert thumbs[0].read_bytes().startswith(PNG_MAGIC)
+
+
+def _setup_in(tmp_path: Path, stamp: str, extras: str) -> tuple[str, str]:
+    """scripts/setup.sh run in a copy of the checkout's set-up files whose .venv's python
+    only records what it is asked; (its calls, the stamp after)."""
+    root = Path(__file__).resolve().parents[1]
+    (tmp_path / "scripts").mkdir(parents=True)
+    (tmp_path / "scripts" / "setup.sh").write_bytes((root / "scripts" / "setup.sh").read_bytes())
+    (tmp_path / "pyproject.toml").write_bytes((root / "pyproject.toml").read_bytes())
+    python = tmp_path / ".venv" / "bin" / "python"
+    python.parent.mkdir(parents=True)
+    python.write_text(f'#!/bin/sh\necho "$*" >> {tmp_path}/calls\n')
+    python.chmod(0o755)
+    (tmp_path / ".venv" / ".opaline-stamp").write_text(stamp + "\n")
+    env = {**os.environ, "OPALINE_EXTRAS": extras, "OPALINE_EXTRA_DEBS": ""}
+    subprocess.run(["bash", str(tmp_path / "scripts" / "setup.sh")], env=env, check=True,
+                   capture_output=True)
+    calls = tmp_path / "calls"
+    return (calls.read_text() if calls.exists() else ""), \
+        (tmp_path / ".venv" / ".opaline-stamp").read_text().strip()
+
+
+def test_setup_keeps_installed_extras_and_installs_missing_ones(tmp_path):
+    """scripts/serve after scripts/test found the stamp's extras ('test') unlike its own
+    (none) and reinstalled, needing the network, every time the two alternated."""
+    import hashlib
+
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256((root / "pyproject.toml").read_bytes()).hexdigest()[:16]
+    calls, stamp = _setup_in(tmp_path / "serve", f"{digest}-test", "")
+    assert calls == "" and stamp == f"{digest}-test"
+    calls, stamp = _setup_in(tmp_path / "test", f"{digest}-", "test")
+    assert "install -q -e .[test]" in calls and stamp == f"{digest}-test"
+    calls, stamp = _setup_in(tmp_path / "changed", "0123456789abcdef-test", "")
+    assert "install -q -e ." in calls and stamp == f"{digest}-"
