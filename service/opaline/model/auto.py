@@ -109,7 +109,10 @@ def load_table(path: Path = TABLE_PATH) -> Table:
 
 def preset_digest(preset: Preset) -> str:
     """Hash of what the table's numbers depend on in a preset: its scene and its defaults."""
-    data = {"scene": preset.scene_key(), "defaults": preset.defaults.model_dump(mode="json")}
+    # mesh_up is a mesh's field, which a preset's defaults do not give (resolve leaves the
+    # mesh fields out of them): not dumped, so adding the field left every entry valid.
+    defaults = preset.defaults.model_dump(mode="json", exclude={"mesh_up"})
+    data = {"scene": preset.scene_key(), "defaults": defaults}
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
 
 

@@ -30,6 +30,8 @@ def mesh_preset(base: Preset, path: Path, digest: str, request: SceneFields, max
                             "tangent_field": request.tangent_field or _default_field(base),
                             "tangent_axis": list(request.tangent_axis or (0.0, 1.0, 0.0)),
                             "max_triangles": max_triangles}
+    if request.mesh_up == "z":  # only then: a Y-up mesh keeps the scene key it had
+        args["up"] = "z"
     defaults = base.defaults.model_copy(
         update={"environment": base.defaults.environment or MESH_ENVIRONMENT})
     update: dict[str, Any] = {"name": f"mesh-{digest[:12]}", "geometry": Generator(**args),

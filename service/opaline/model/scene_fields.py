@@ -21,7 +21,7 @@ from opaline.scene.environments import BUILTIN, MESH_ENVIRONMENT, NO_ENVIRONMENT
 TangentField = Literal["auto", "uv", "concentric", "projected"]
 Finite3 = tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
                 Annotated[float, Field(ge=-1e6, le=1e6)]]
-MESH_FIELDS = ("mesh", "tangent_field", "tangent_axis")
+MESH_FIELDS = ("mesh", "tangent_field", "tangent_axis", "mesh_up")
 ORBIT_FIELDS = ("camera_azimuth", "camera_elevation", "camera_distance")
 BUILT_IN = ", ".join(f"'{name}'" for name in BUILTIN)
 
@@ -47,6 +47,16 @@ class SceneFields(BaseModel):
         None, description="Axis of the concentric field, or direction of the projected one "
                           "(default 0,1,0; an axis of length under 1e-9, which has no "
                           "direction, is the default).")
+
+    mesh_up: Literal["y", "z"] | None = Field(
+        None, description="The mesh file's up axis: 'y' (default; glTF's) or 'z' (many scans "
+                          "and CAD exports: OBJ, PLY and STL cannot say which): a Z-up file is "
+                          "turned so that its +z is up, before its tangents and maps.")
+
+    @field_validator("mesh_up")
+    @classmethod
+    def _up(cls, up: str | None) -> str | None:
+        return None if up == "y" else up  # the default, one URL and key whether named or not
 
     @field_validator("tangent_axis")
     @classmethod

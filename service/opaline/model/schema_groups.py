@@ -19,7 +19,7 @@ GROUPS: list[tuple[str, str, tuple[str, ...]]] = [
     ("light", "Light", ("light_azimuth", "light_elevation")),
     ("output", "Output", ("width", "height", "quality", "format", "exposure", "tonemap",
                           "color_space", "transparent")),
-    ("scene", "Mesh and camera", ("mesh", "tangent_field", "tangent_axis", "camera_azimuth",
+    ("scene", "Mesh and camera", ("mesh", "tangent_field", "tangent_axis", "mesh_up", "camera_azimuth",
                                   "camera_elevation", "camera_distance")),
     ("environment", "Environment", ("environment", "environment_rotation",
                                     "environment_intensity", "environment_lights",

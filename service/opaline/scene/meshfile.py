@@ -135,12 +135,16 @@ def admit(data: bytes, suffix: str = "",
 
 def build_mesh(data: bytes, fmt: str, field: str = "auto",
                axis: Sequence[float] = (0.0, 1.0, 0.0),
-               max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
+               max_triangles: int = DEFAULT_MAX_TRIANGLES, up: str = "y") -> tuple[Mesh, MeshSummary]:
     """``parse_mesh`` of bytes that ``admit`` passed: trimesh's parse, then the checks of
-    what it built (counts, indices, finite and drawable coordinates, some area)."""
+    what it built (counts, indices, finite and drawable coordinates, some area). A Z-up
+    file (``up`` "z") is turned a quarter about x, (x, y, z) → (x, z, −y), a rotation (it
+    keeps the winding), so that its +z is up before its normals, tangents and bounds."""
     loaded = _parse(data, fmt)
     faces = np.asarray(loaded.faces, dtype=np.int64)
     positions = np.asarray(loaded.vertices, dtype=np.float64)
+    if up == "z":
+        positions = np.stack([positions[:, 0], positions[:, 2], -positions[:, 1]], axis=1)
     if len(faces) > max_triangles:
         raise MeshError(f"{len(faces)} triangles is over this service's limit of {max_triangles}")
     if faces.min() < 0 or faces.max() >= len(positions):
@@ -171,19 +175,20 @@ def build_mesh(data: bytes, fmt: str, field: str = "auto",
     return mesh, summary
 
 
-# (path, size, mtime, field, axis, max_triangles) -> parse_mesh's answer
-_loaded: OrderedDict[tuple[str, int, int, str, tuple[float, ...], int],
+# (path, size, mtime, field, axis, max_triangles, up) -> parse_mesh's answer
+_loaded: OrderedDict[tuple[str, int, int, str, tuple[float, ...], int, str],
                     tuple[Mesh, MeshSummary]] = OrderedDict()
 
 
 def load_mesh_file(path: str | Path, field: str = "auto",
                    axis: Sequence[float] = (0.0, 1.0, 0.0),
-                   max_triangles: int = DEFAULT_MAX_TRIANGLES) -> tuple[Mesh, MeshSummary]:
+                   max_triangles: int = DEFAULT_MAX_TRIANGLES,
+                   up: str = "y") -> tuple[Mesh, MeshSummary]:
     """``parse_mesh`` of a file, the last few kept (keyed by path, size and mtime)."""
     path = Path(path)
     try:
         stat = path.stat()
-        key = (str(path), stat.st_size, stat.st_mtime_ns, field, tuple(axis), max_triangles)
+        key = (str(path), stat.st_size, stat.st_mtime_ns, field, tuple(axis), max_triangles, up)
         if key in _loaded:
             _loaded.move_to_end(key)
             return _loaded[key]
@@ -199,7 +204,7 @@ def load_mesh_file(path: str | Path, field: str = "auto",
         # ever refuses files never grows by them.
         importlib.import_module("trimesh")
         with parse_ceiling():
-            found = build_mesh(data, fmt, field, axis, max_triangles)
+            found = build_mesh(data, fmt, field, axis, max_triangles, up)
     except MemoryError:
         headroom = (parse_headroom() or 0) >> 20
         raise MeshError(f"mesh {path.name} needs more than {headroom} MB to read, over this "
@@ -212,7 +217,7 @@ def load_mesh_file(path: str | Path, field: str = "auto",
 
 def mesh_file(path: str, digest: str = "", tangent_field: str = "auto",
               tangent_axis: Sequence[float] = (0.0, 1.0, 0.0),
-              max_triangles: int = DEFAULT_MAX_TRIANGLES) -> Mesh:
+              max_triangles: int = DEFAULT_MAX_TRIANGLES, up: str = "y") -> Mesh:
     """The geometry generator ``file``: ``digest`` is unused here but names the content in
     the preset's scene key, so a changed file never draws from a stale GPU copy."""
-    return load_mesh_file(path, tangent_field, tuple(tangent_axis), max_triangles)[0]
+    return load_mesh_file(path, tangent_field, tuple(tangent_axis), max_triangles, up)[0]

@@ -14,7 +14,8 @@ import { same } from './dom.js';
 import { state, TIER_MATERIAL, tierSetting } from './state.js';
 
 // pipeline/canonical.py REQUEST_ONLY: the fields a job does not keep, right after the preset.
-export const REQUEST_ONLY = ['mesh', 'tangent_field', 'tangent_axis', 'max_flip', 'max_delta_e'];
+export const REQUEST_ONLY = ['mesh', 'tangent_field', 'tangent_axis', 'mesh_up', 'max_flip',
+  'max_delta_e'];
 // model/tiers.py render_settings: what a tier sets unless the preset sets its own.
 export const TIER_SETTINGS = ['samples', 'wavelengths', 'aa'];
 
