@@ -154,6 +154,25 @@ def test_invalid_request_raises_with_field_value_and_range(on_thread):
     assert isinstance(info.value, ValueError)
 
 
+@pytest.mark.parametrize("field, value", [("mu_f", True), ("mu_f", "6"), ("width", "32"),
+                                          ("transparent", "yes")])
+def test_values_are_read_as_a_json_body_reads_them(field, value):
+    """A string for a number or for a boolean, or a boolean for a number, is refused as
+    POST /v1/render and a material file refuse it; before, the Python API took them (True
+    drew mu_f=1)."""
+    with pytest.raises(api_python.RequestError) as info:
+        api_python.as_request({"preset": "cd-rom", field: value})
+    assert info.value.problems[0].startswith(f"{field}=")
+
+
+def test_numpy_numbers_and_python_tuples_are_read():
+    request = api_python.as_request({"preset": "cd-rom", "mu_f": np.float32(2.5),
+                                     "width": np.int64(64), "albedo": np.array([0.1, 0.2, 0.5]),
+                                     "metal_f0": (0.9, 0.6, 0.5), "height": 48.0})
+    assert (request.mu_f, request.width, request.height) == (2.5, 64, 48)
+    assert request.albedo == pytest.approx((0.1, 0.2, 0.5))
+
+
 def test_unknown_preset_and_wrong_type_raise(on_thread):
     """An unknown preset raises UnknownPreset; a non-request argument raises TypeError."""
     with pytest.raises(UnknownPreset):

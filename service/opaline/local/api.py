@@ -26,6 +26,7 @@ from pydantic import ValidationError
 
 from opaline.local.pipeline import LocalRenderer
 from opaline.model.params import RenderRequest, describe_errors
+from opaline.model.strict_json import validate_strictly
 from opaline.settings import BackendName
 
 # A request model, its fields as a mapping, or the path of a material file (.toml/.json).
@@ -64,8 +65,8 @@ def as_request(request: RequestLike) -> RenderRequest:
     if not isinstance(request, Mapping):
         raise TypeError("expected a RenderRequest, a mapping, or a material file's path, "
                         f"got {type(request).__name__}")
-    try:
-        return RenderRequest.model_validate(dict(request))
+    try:  # as a JSON body is read: {"mu_f": "6"} and {"mu_f": True} are refused there too
+        return validate_strictly(dict(request), RenderRequest)
     except ValidationError as exc:
         raise RequestError(describe_errors(exc)) from None
 

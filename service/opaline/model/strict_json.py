@@ -50,14 +50,23 @@ def refuse_duplicate_keys(text: str | bytes, where: str) -> None:
     json.loads(text, object_pairs_hook=unique)
 
 
+def _plain(value: Any) -> Any:
+    """A NumPy scalar or array as its Python number or list (``opaline.render`` is given
+    them); anything else as its text, which no number or boolean field takes."""
+    tolist = getattr(value, "tolist", None)
+    return tolist() if callable(tolist) else str(value)
+
+
 def validate_strictly(data: Any, model: type[Model]) -> Model:
-    """``data`` (parsed JSON or TOML) as ``model``, in pydantic's strict JSON mode."""
+    """``data`` (parsed JSON or TOML, or a caller's dict) as ``model``, in pydantic's strict
+    JSON mode."""
     if isinstance(data, dict):
         for name in integer_fields(model) & data.keys():
             value = data[name]
             if isinstance(value, float) and value.is_integer():
                 data[name] = int(value)
-    return model.model_validate_json(to_json(data, inf_nan_mode="constants"), strict=True)
+    text = to_json(data, inf_nan_mode="constants", fallback=_plain)
+    return model.model_validate_json(text, strict=True)
 
 
 @cache
