@@ -201,6 +201,25 @@ def test_environment_picker_backdrop_and_blur(page):
     assert page.locator("#in-environment-file").is_hidden()
 
 
+def test_quick_picker_gives_the_presets_lights_and_names_a_file(page):
+    """On a preset lit by a map by default, "the preset's lights" is environment=none (it
+    snapped back to the studio); a file's name shows as itself (it showed "the preset's
+    lights"); an unknown file's 404 is shown by the environment control, not at the top."""
+    open_page(page, "?preset=soap-bubble")
+    assert page.input_value("#env-pick") == "studio"
+    page.select_option("#env-pick", "none")
+    settle(page)
+    assert "environment=none" in page.get_attribute("#preview", "data-url")
+    assert page.input_value("#env-pick") == "none"
+    page.select_option("#in-environment", label="file…")
+    page.fill("#in-environment-file", "nowhere.hdr")
+    page.press("#in-environment-file", "Enter")
+    settle(page)
+    assert page.input_value("#env-pick") == "nowhere.hdr"
+    assert "nowhere.hdr" in page.text_content("#err-environment")
+    assert page.locator("#err-environment").is_visible()
+
+
 def test_copied_curl_returns_the_shown_bytes(page, tmp_path):
     """Dragging the preview moves the light; "Copy as curl", run, gets the bytes shown."""
     open_page(page, "?preset=cd-rom")

@@ -5,7 +5,7 @@ import { postJSON, problemOf, request } from './api.js';
 import { $, save, sleep } from './dom.js';
 import { renderQuery } from './queries.js';
 import { imageFileName } from './share.js';
-import { changedFields, setValue, state } from './state.js';
+import { changedFields, defaultOf, setValue, state } from './state.js';
 
 const POLL_MS = 300;
 
@@ -88,8 +88,12 @@ async function download(what, ask, name) {
 
 export function setupAssets() {
   setupDrop();
+  // "none" is the preset's own lights: an override only where the preset's default is a
+  // map (soap-bubble's studio), else the default itself.
   $('#env-pick').addEventListener('change', (event) => {
-    setValue('environment', event.target.value || null, 'picker');
+    const value = event.target.value;
+    const none = value === 'none' && [null, undefined, 'none'].includes(defaultOf('environment'));
+    setValue('environment', none ? null : value, 'picker');
   });
   // A link (to copy or open), but a click fetches it: a link cannot carry the API key.
   $('#dl-image').addEventListener('click', (event) => {

@@ -34,9 +34,17 @@ export function refreshField(name, source) {
   if (!control) return;
   control.show(valueOf(name), source);
   // Quick pickers elsewhere on the page (data-mirrors) show the same value.
+  // A value none of its options has (a file's name) gets an option of its own, where the
+  // first option ("the preset's lights") had been shown.
   for (const mirror of document.querySelectorAll(`select[data-mirrors="${name}"]`)) {
-    const value = valueOf(name) ?? '';
-    mirror.value = [...mirror.options].some((o) => o.value === value) ? value : '';
+    const value = valueOf(name) ?? mirror.options[0].value;
+    let own = mirror.querySelector('option[data-own]');
+    if (![...mirror.options].some((o) => o.value === value && o !== own)) {
+      if (!own) mirror.append(own = h('option', { 'data-own': '' }));
+      own.value = value;
+      own.textContent = `file: ${value}`;
+    } else if (own) own.remove();
+    mirror.value = value;
   }
   const changed = name in state.overrides;
   control.wrap.classList.toggle('changed', changed);

@@ -16,7 +16,15 @@ export function routeErrors(problems) {
     if (![...byPlace.values()].some((shown) => shown.includes(line))) byPlace.set(place, [...list, line]);
   };
   for (const { fields = [] } of problems) for (const f of fields) add(placeOf(f.field), f.message);
-  for (const { lines } of problems) for (const line of lines) add('general', line);
+  // A problem the service answers without fields (a 404's unknown environment or mesh, a
+  // map that cannot be read) is shown by its control when its line starts with the field's
+  // name, as every message does ("environment='x' is not known", "environment x.hdr: …").
+  for (const { lines, fields = [] } of problems) {
+    for (const line of lines) {
+      const named = fields.length ? null : /^([a-z][a-z0-9_]*)[= ]/.exec(line);
+      add(named && state.controls.has(named[1]) ? named[1] : 'general', line);
+    }
+  }
   for (const [place, lines] of byPlace) showError(place, lines);
   return [...byPlace.keys()].filter((place) => state.controls.has(place));
 }
