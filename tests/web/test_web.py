@@ -129,6 +129,11 @@ def test_page_loads_with_controls_from_the_schema(page):
     tonemaps = page.eval_on_selector_all("#in-tonemap option", "os => os.map(o => o.value)")
     assert tonemaps == ["none", "reinhard", "aces", "neutral"]
     assert page.input_value("#in-tonemap") == "neutral"  # the default, shown as chosen
+    # A colour has a picker; a direction has none, and shows nothing while unset (it had a
+    # colour picker and showed 0,0,0 where the default is 0,1,0).
+    assert page.locator("#in-albedo-color").count() == 1
+    assert page.locator("#in-tangent_axis-color").count() == 0
+    assert page.input_value("#in-tangent_axis-1") == ""
 
 
 def test_preset_and_slider_change_the_preview(page):

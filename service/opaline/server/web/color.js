@@ -20,14 +20,18 @@ function linearOf(hex) {
 export function vectorControl(spec) {
   const name = spec.name;
   const shell = fieldShell(spec, `in-${name}-0`);
-  const names = ['red', 'green', 'blue'];
+  // A colour (each item within 0 … 1) has a picker and R, G, B; a direction
+  // (tangent_axis) has neither: X, Y, Z, empty while unset (its default is the service's).
+  const isColour = spec.items.every((range) => range.min >= 0 && range.max <= 1);
+  const names = isColour ? ['red', 'green', 'blue'] : ['x', 'y', 'z'];
   const inputs = spec.items.map((range, i) =>
     numberInput(`in-${name}-${i}`, range, `${name} ${names[i]}`, `desc-${name} err-${name}`));
-  const color = h('input', { type: 'color', id: `in-${name}-color`,
-    'aria-label': `${name} colour picker (sRGB)`, 'aria-describedby': `desc-${name}` });
+  const color = isColour ? h('input', { type: 'color', id: `in-${name}-color`,
+    'aria-label': `${name} colour picker (sRGB)`, 'aria-describedby': `desc-${name}` }) : null;
   const row = h('div', { class: 'inputs vector' }, color);
   inputs.forEach((input, i) => {
-    row.append(h('label', { class: 'channel', for: input.id, text: 'RGB'[i] }), input);
+    row.append(h('label', { class: 'channel', for: input.id, text: (isColour ? 'RGB' : 'XYZ')[i] }),
+      input);
     input.addEventListener('input', () => {
       const value = inputs.map((x) => Number(x.value));
       if (input.validity.badInput || input.value.trim() === '' || value.some((x) => !Number.isFinite(x))) {
@@ -35,15 +39,15 @@ export function vectorControl(spec) {
       } else setValue(name, value, input);
     });
   });
-  color.addEventListener('input', () => setValue(name, linearOf(color.value), color));
+  if (color) color.addEventListener('input', () => setValue(name, linearOf(color.value), color));
   shell.wrap.append(row, shell.desc, shell.err);
   return {
     ...shell,
-    inputs: [...inputs, color],
+    inputs: color ? [...inputs, color] : inputs,
     show(value, source) {
-      const rgb = value || [0, 0, 0];
-      inputs.forEach((input, i) => { if (source !== input) input.value = String(rgb[i]); });
-      if (source !== color) color.value = hexOf(rgb);
+      const shown = value || (isColour ? [0, 0, 0] : ['', '', '']);
+      inputs.forEach((input, i) => { if (source !== input) input.value = String(shown[i]); });
+      if (color && source !== color) color.value = hexOf(value || [0, 0, 0]);
     },
   };
 }
