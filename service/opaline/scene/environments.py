@@ -67,8 +67,12 @@ def check_name(name: str, folder: Path | None) -> Path | None:
         path = Path(folder) / name
         if path.is_file():
             return path
+    # A path is not a name: a file is named as it is in the folder (which the message
+    # names by its setting: the CLI user whose path was refused has to know where it goes).
+    where = ("the environments folder (OPALINE_ENVIRONMENTS_DIR)" if folder is not None
+             else "an environments folder, and OPALINE_ENVIRONMENTS_DIR names none here")
     raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, neutral, "
-                            "sky, none, or an .hdr/.exr file of the environments folder")
+                              f"sky, none, or the name of an .hdr/.exr file of {where}")
 
 
 def map_identity(name: str, folder: Path | None) -> tuple[object, ...]:
