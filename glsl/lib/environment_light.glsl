@@ -207,7 +207,9 @@ vec3 env_sample_weight(Material mat, realmat3 frame, vec3 v, vec3 vl, vec3 hl, v
 #elif defined(IRIDESCENCE_THIN_FILM)
     return mat.ks * film_colour(mat, vh, film_nm) * (ll.z / max(max(ll.z, vl.z), EPS_DENOM));
 #else
-    return specular(mat, frame, vec3(frame * real3(ll)), v, film_nm) * ll.z / pdf_l;
+    // The view as the sample saw it (env_view_above), back in the world.
+    return specular(mat, frame, vec3(frame * real3(ll)), vec3(frame * real3(vl)), film_nm)
+           * ll.z / pdf_l;
 #endif
 }
 
