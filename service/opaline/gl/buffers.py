@@ -143,7 +143,7 @@ class SceneGPU:
             self.normal_map.repeat_x, self.normal_map.repeat_y = True, wraps_v
         self.thickness_map = physical.thickness_texture(ctx, build_thickness(preset), wraps_v)
         self.weight_map = physical.thickness_texture(ctx, build_weight(preset), wraps_v)
-        self.culling = Culling(mesh.positions, mesh.indices)
+        self.culling = Culling(mesh.positions, mesh.indices, planes=not is_mesh(preset))
         # Mipmaps add a third to a texture.
         self.nbytes = self.vbo.size + self.ibo.size + sum(
             tex.width * tex.height * tex.components * 4 * 4 // 3

@@ -21,9 +21,15 @@ from opaline.scene.closed import orientation, referenced
 class Culling:
     """What one scene's mesh allows: decided once per mesh, then per view from 8 corners."""
 
-    def __init__(self, positions: np.ndarray, indices: np.ndarray) -> None:
-        self.positions, self.indices = positions, indices
-        self._planes: tuple[np.ndarray, np.ndarray] | None = None  # (normals, n·p), lazily
+    def __init__(self, positions: np.ndarray, indices: np.ndarray,
+                 planes: bool = True) -> None:
+        # Each triangle's plane (its normal, n·p), for shows_back: kept for the built-in
+        # meshes, whose few thousand triangles cost little; not for a user's (up to 2M).
+        self._planes: tuple[np.ndarray, np.ndarray] | None = None
+        if planes:
+            corners = positions.astype(np.float64)[indices.reshape(-1, 3)]
+            normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+            self._planes = (normals, np.einsum("ij,ij->i", normals, corners[:, 0]))
         self.sign = orientation(positions, indices)
         closed = self.sign != 0
         self.corners = np.zeros((8, 3))
@@ -53,14 +59,12 @@ class Culling:
         return "ccw" if self.sign * determinant > 0.0 else "cw"
 
     def shows_back(self, model: np.ndarray, eye: tuple[float, ...]) -> bool:
-        """Whether the eye sees some triangle from behind (the side its winding, and so its
-        vertex normals, do not face); asked of the built-in meshes. The sign of n·(eye − p)
-        is kept by any affine model matrix (normals turn by its inverse transpose), so the
-        test runs in object space, on each triangle's plane, kept from the first time."""
+        """Whether the eye may see some triangle from behind (the side its winding, and so
+        its vertex normals, do not face): without the planes, it may. The sign of
+        n·(eye − p) is kept by any affine model matrix (normals turn by its inverse
+        transpose), so the test runs in object space."""
         if self._planes is None:
-            corners = self.positions.astype(np.float64)[self.indices.reshape(-1, 3)]
-            normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-            self._planes = (normals, np.einsum("ij,ij->i", normals, corners[:, 0]))
+            return True
         normals, offsets = self._planes
         eye_object = (np.append(np.asarray(eye, dtype=np.float64), 1.0)
                       @ np.linalg.inv(np.asarray(model, dtype=np.float64)))[:3]

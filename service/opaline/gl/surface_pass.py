@@ -32,7 +32,6 @@ from opaline.gl.resources import Resources
 from opaline.model import color_space
 from opaline.model.camera import fit_matrix, model_matrix, view_camera, view_projection
 from opaline.model.environment_light import reads_map
-from opaline.model.meshes import is_mesh
 from opaline.model.presets import Preset
 from opaline.model.request import Job
 from opaline.model.spectrum import wavelength_shift
@@ -101,8 +100,7 @@ class SurfacePass:
         front_face = scene.culling.front_face(where.model, where.view_proj)
         # Backs are shaded as fronts where one can be seen: not where culled, and on a
         # built-in mesh only if this view sees one (a user's mesh not culled may).
-        two_sided = front_face is None and (
-            is_mesh(preset) or scene.culling.shows_back(where.model, where.eye))
+        two_sided = front_face is None and scene.culling.shows_back(where.model, where.eye)
         program = self._program(job, preset, scene, plan, where, two_sided)
         background = self.backgrounds.prepare(self.resources.programs, job, where.view_proj,
                                               targets.size)

@@ -13,13 +13,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from opaline.digests import known_file_digest
 from opaline.errors import PublicError
 from opaline.model.params import RenderRequest
 from opaline.model.presets import Preset, get_preset
 from opaline.model.request import Job, resolve
 from opaline.pipeline.canonical import canonical_query, canonical_url
 from opaline.pipeline.limits import Limits, check_limits
-from opaline.scene.environment_files import EnvironmentMapError, file_digest
+from opaline.scene.environment_files import EnvironmentMapError
 from opaline.scene.environments import check_name
 
 # How a request's mesh becomes a preset: a file on this machine (CLI, Python, batches) or
@@ -85,7 +86,7 @@ def scene(request: RenderRequest, named: Preset, context: Context) -> tuple[Pres
         except EnvironmentMapError as exc:
             raise UnknownEnvironment(str(exc)) from None
         if path is not None:
-            key = f"{key}+{file_digest(path)}"
+            key = f"{key}+{known_file_digest(path)}"
     return preset, key
 
 

@@ -16,8 +16,9 @@ linear RGB float32 in the equirectangular convention of ``mediancut``:
   direction's radiance. A uniform map then lights alike at any size: at 1 × 1 its
   irradiance's constant term was 4.93 where π is right, one row's texels all taken at
   the equator's solid angle.
-* **Named by content** (``file_digest``), so a file replaced under the same name is a new
-  scene: keys, revs and the workers' caches follow the bytes, not the name.
+* **Named by content** (``digests.known_file_digest``, in ``pipeline.prepare``), so a file
+  replaced under the same name is a new scene: keys and revs follow the bytes, and the
+  workers' caches the file's size and time (``environments.map_identity``).
 """
 
 from __future__ import annotations
@@ -28,8 +29,6 @@ import re
 from pathlib import Path
 
 import numpy as np
-
-from opaline.digests import file_digest as content_digest
 
 # The most radiance a file's texel keeps. Far above any real scene in relative units (a
 # sun is ~1e5 times its sky); below it every range at its end (environment_intensity
@@ -146,17 +145,3 @@ def fit(radiance: np.ndarray) -> np.ndarray:
     if repeat_x > 1 or repeat_y > 1:
         radiance = np.repeat(np.repeat(radiance, repeat_y, axis=0), repeat_x, axis=1)
     return np.ascontiguousarray(radiance, dtype=np.float32)
-
-
-_digests: dict[tuple[str, int, int], str] = {}
-
-
-def file_digest(path: Path) -> str:
-    """The file's content hash, computed again only when its size or time changes."""
-    stat = path.stat()
-    key = (str(path), stat.st_size, stat.st_mtime_ns)
-    if key not in _digests:
-        if len(_digests) >= 256:
-            _digests.clear()
-        _digests[key] = content_digest(path)
-    return _digests[key]

@@ -24,7 +24,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from opaline import scratch
-from opaline.digests import file_digest
+from opaline.digests import known_file_digest
 from opaline.errors import PublicError
 from opaline.lru import BudgetLRU
 from opaline.model.meshes import mesh_preset
@@ -86,7 +86,6 @@ class MeshStore:
         self.folder = settings.meshes_dir
         self._lock = threading.Lock()
         self._sizes: OrderedDict[str, int] = OrderedDict()
-        self._folder_digests: dict[tuple[str, int, int], str] = {}
         self.evictions = 0
         self._touch_after = 0.0
         # What the check answered of each (JSON, ~200 bytes), for GET /v1/meshes/{id}.
@@ -167,7 +166,7 @@ class MeshStore:
             except (OSError, ValueError):  # a name no file can have (over 255 bytes, a NUL)
                 found = False
             if found:
-                return path, self._folder_digest(path)
+                return path, known_file_digest(path)
         raise UnknownMesh(name)
 
     def _used(self, mesh_id: str) -> Path:
@@ -180,13 +179,6 @@ class MeshStore:
             except StoreUnavailable:
                 self._touch_after = time.monotonic() + TOUCH_PAUSE_S
         return self.path_of(mesh_id)
-
-    def _folder_digest(self, path: Path) -> str:
-        stat = path.stat()
-        key = (str(path), stat.st_size, stat.st_mtime_ns)
-        if key not in self._folder_digests:
-            self._folder_digests[key] = file_digest(path)
-        return self._folder_digests[key]
 
     def _touch(self, mesh_id: str) -> None:
         self._sizes.move_to_end(mesh_id)
