@@ -36,7 +36,7 @@ def renderer(backend):
     from opaline.gl.renderer import Renderer
     from opaline.settings import setting
 
-    r = Renderer(backend, environments_dir=setting("environments_dir"))
+    r = Renderer(backend, environments_dir=setting("environments_dir"), environment_paths=True)
     yield r
     r.release()
 

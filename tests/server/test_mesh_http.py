@@ -166,13 +166,19 @@ def test_http_process_never_imports_a_mesh_parser():
 
 
 @pytest.mark.gl
-def test_environment_over_http(client):
+def test_environment_over_http(client, tmp_path):
+    """Names only: a path is refused, even to a map that exists (the CLI takes paths)."""
+    cv2 = pytest.importorskip("cv2")
+    on_disk = tmp_path / "room.hdr"
+    assert cv2.imwrite(str(on_disk), np.ones((8, 16, 3), np.float32))
     lit = client.get(f"/v1/render?preset=sphere&environment=sky&environment_lights=8&{SMALL}")
     assert lit.status_code == 200 and lit.content.startswith(b"\x89PNG")
     for path in ("/v1/render", "/v1/export/glsl"):
-        unknown = client.get(f"{path}?preset=sphere&environment=../x.hdr&{SMALL}")
-        assert unknown.status_code == 404 and "not known" in unknown.json()["detail"][0]
-        assert unknown.json()["error"] == "unknown_environment"
+        for name in ("../x.hdr", str(on_disk)):
+            unknown = client.get(f"{path}?preset=sphere&environment={name}&{SMALL}")
+            assert unknown.status_code == 404 and "not known" in unknown.json()["detail"][0]
+            assert unknown.json()["error"] == "unknown_environment"
+            assert "file's path" not in unknown.json()["detail"][0]  # nor offered one
 
 
 @pytest.mark.gl

@@ -46,7 +46,8 @@ class GLProcesses:
 
         from opaline.settings import setting
 
-        factory = RendererFactory(backend, environments_dir=setting("environments_dir"))
+        factory = RendererFactory(backend, environments_dir=setting("environments_dir"),
+                                  environment_paths=True)
         self.pool = WorkerPool(factory, workers=jobs, queue_size=1 << 20,
                                deadline_s=NO_DEADLINE_S, render_timeout_s=RENDER_LIMIT_S,
                                lp_threads=max(1, (os.cpu_count() or 1) // jobs))

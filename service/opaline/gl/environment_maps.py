@@ -32,13 +32,15 @@ class EnvironmentMap:
 
 
 class EnvironmentMaps:
-    def __init__(self, ctx: moderngl.Context, environments_dir: Path | None) -> None:
+    def __init__(self, ctx: moderngl.Context, environments_dir: Path | None,
+                 paths: bool = False) -> None:
         self.ctx = ctx
         self.environments_dir = environments_dir
+        self.paths = paths  # a map may be named by its path (scene.environments.check_name)
         self._maps: OrderedDict[tuple[object, ...], EnvironmentMap] = OrderedDict()
 
     def get(self, name: str) -> EnvironmentMap:
-        key = map_identity(name, self.environments_dir)  # a file replaced is read again
+        key = map_identity(name, self.environments_dir, self.paths)  # a file replaced is read again
         found = self._maps.get(key)
         if found is None:
             found = self._upload(name)
@@ -49,7 +51,7 @@ class EnvironmentMaps:
         return found
 
     def _upload(self, name: str) -> EnvironmentMap:
-        radiance, directions, lights = split_bright(resolve_map(name, self.environments_dir))
+        radiance, directions, lights = split_bright(resolve_map(name, self.environments_dir, self.paths))
         height, width = radiance.shape[:2]
         # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
         # RGBA, the fourth channel unread: llvmpipe fetches 16-byte texels faster than

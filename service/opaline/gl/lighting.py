@@ -9,8 +9,7 @@ the map, its diffuse part too).
 
 from __future__ import annotations
 
-from pathlib import Path
-
+from opaline.gl.environment_maps import EnvironmentMaps
 from opaline.gl.uniforms import Vector
 from opaline.model.camera import place_key_light
 from opaline.model.presets import Preset
@@ -18,14 +17,13 @@ from opaline.model.request import Job
 from opaline.scene.environments import environment_lights
 
 
-def light_uniforms(job: Job, preset: Preset,
-                   environments_dir: Path | None) -> dict[str, list[Vector]]:
+def light_uniforms(job: Job, preset: Preset, maps: EnvironmentMaps) -> dict[str, list[Vector]]:
     """``u_light_position`` (xyz and w: 1 point, 0 directional) and ``u_light_irradiance``."""
     if job.environment:
         direction, irradiance = environment_lights(
             job.environment, job.environment_count, job.environment_rotation or 0.0,
             1.0 if job.environment_intensity is None else job.environment_intensity,
-            environments_dir)
+            maps.environments_dir, maps.paths)
         return {"u_light_position": [(*map(float, d), 0.0) for d in direction],
                 "u_light_irradiance": [tuple(map(float, e)) for e in irradiance]}
     lights = place_key_light(preset.lights, preset.camera.target, job.light_azimuth,

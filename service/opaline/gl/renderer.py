@@ -41,17 +41,18 @@ class Renderer:
     """Draws jobs, MDF plots and BRDF probes on its own headless context.
 
     ``environments_dir``: where user environment maps are looked up (the settings'
-    ``environments_dir``; None: the built-in ones only)."""
+    ``environments_dir``; None: the built-in ones only); ``environment_paths``: a map may
+    also be named by its path (the CLI's and the Python API's renderers, not a worker's)."""
 
     def __init__(self, backend: str | None = None, gl: GLContext | None = None,
                  budgets: RenderBudgets | None = None,
-                 environments_dir: Path | None = None) -> None:
+                 environments_dir: Path | None = None, environment_paths: bool = False) -> None:
         self.gl = gl or create_context(backend)
         self.budgets = budgets or RenderBudgets()
         self.resources = Resources(self.gl, self.budgets)
-        self.environments = EnvironmentMaps(self.ctx, environments_dir)
+        self.environments = EnvironmentMaps(self.ctx, environments_dir, environment_paths)
         self.backgrounds = Backgrounds(self.ctx, self.resources.fullscreen, self.environments)
-        self.surface = SurfacePass(self.resources, self.backgrounds, environments_dir)
+        self.surface = SurfacePass(self.resources, self.backgrounds)
         self.resolver = Resolver(self.resources)
         self.probes = Probes(self.resources)
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -87,11 +86,9 @@ def place(job: Job, preset: Preset, scene: SceneGPU, size: tuple[int, int]) -> P
 
 
 class SurfacePass:
-    def __init__(self, resources: Resources, backgrounds: Backgrounds,
-                 environments_dir: Path | None) -> None:
+    def __init__(self, resources: Resources, backgrounds: Backgrounds) -> None:
         self.resources = resources
         self.backgrounds = backgrounds
-        self.environments_dir = environments_dir
 
     def draw(self, job: Job, preset: Preset, targets: Targets, plan: DrawPlan,
              should_stop: Callable[[], bool] | None = None) -> None:
@@ -151,7 +148,7 @@ class SurfacePass:
             defines.update(environment_light.defines(job, plan.samples, environment, plan.brute))
             environment.texture.use(location=texture_units.ENVIRONMENT)
             return environment_light.uniforms(job, plan.samples, environment, plan.brute)
-        lights = light_uniforms(job, preset, self.environments_dir)
+        lights = light_uniforms(job, preset, self.backgrounds.maps)
         defines["LIGHT_COUNT"] = len(lights["u_light_position"])
         return dict(lights)
 

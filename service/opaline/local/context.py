@@ -1,5 +1,5 @@
 """What a request is prepared against in this process (CLI, Python API, local batches):
-mesh files on this machine and the ``OPALINE_*`` settings. No GL is loaded here."""
+mesh and environment files on this machine and the ``OPALINE_*`` settings. No GL is loaded here."""
 
 from __future__ import annotations
 
@@ -17,5 +17,7 @@ def file_meshes(request: RenderRequest, preset: Preset) -> Preset:
 
 
 def local_context(cost_budget: int | None) -> Context:
-    """Requests prepared in this process: files for meshes, the OPALINE_* settings."""
-    return Context(Limits(cost_budget), file_meshes, setting("environments_dir"))
+    """Requests prepared in this process: files for meshes and environments, the
+    OPALINE_* settings."""
+    return Context(Limits(cost_budget), file_meshes, setting("environments_dir"),
+                   environment_paths=True)

@@ -45,7 +45,8 @@ class LocalRenderer:
     """Renders requests on a private headless context."""
 
     def __init__(self, backend: str | None = None, cost_budget: int | None = None) -> None:
-        self.renderer = Renderer(backend, environments_dir=setting("environments_dir"))
+        self.renderer = Renderer(backend, environments_dir=setting("environments_dir"),
+                                 environment_paths=True)
         self.cost_budget = cost_budget  # None: OPALINE_COST_BUDGET, as in the HTTP service
 
     @property

@@ -19,6 +19,7 @@ from pydantic import ValidationError
 
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.strict_json import DuplicateKey, refuse_duplicate_keys, validate_strictly
+from opaline.scene.environments import SUFFIXES as ENVIRONMENT_SUFFIXES
 
 SUFFIXES = (".toml", ".json")
 SCHEMA_KEY = "$schema"  # allowed in files so editors can find the schema; ignored
@@ -122,12 +123,27 @@ def load_material(path: Path | str, overrides: dict[str, Any] | None = None) -> 
     if isinstance(fields.get("mesh"), str) and "mesh" in own:
         # A mesh written in the file is relative to the file, as an editor sees it.
         fields["mesh"] = str(path.parent / Path(fields["mesh"]).expanduser())
+    if isinstance(fields.get("environment"), str) and "environment" in own:
+        fields["environment"] = environment_beside(path, fields["environment"])
     try:
         return validate(fields, set(fields) - own)
     except ValidationError as exc:
         line = _first_line(exc, text, own, path.suffix.lower() == ".json")
         raise MaterialError(f"{at(path, line)}: " + "; ".join(describe_errors(exc)), path,
                             line) from None
+
+
+def environment_beside(path: Path, environment: str) -> str:
+    """An environment file written in a material file: a path is relative to the file, as
+    a mesh is, and so is a bare file name that is there. Any other name is a built-in's or
+    one of the environments folder's (scene.environments.check_name)."""
+    if not environment.lower().endswith(ENVIRONMENT_SUFFIXES):
+        return environment
+    written = Path(environment).expanduser()
+    beside = path.parent / written
+    if written.name != environment or beside.is_file():
+        return str(beside)
+    return environment
 
 
 def _first_line(exc: ValidationError, text: str, own: Iterable[str], is_json: bool) -> int | None:

@@ -83,7 +83,9 @@ class SceneFields(BaseModel):
 
     environment: Annotated[str, Field(min_length=1, max_length=255)] | None = Field(
         None, description="Light the scene with an environment instead of the preset's lights: "
-                          f"{BUILT_IN}, or an .hdr/.exr file of the environments folder; "
+                          f"{BUILT_IN}, or an .hdr/.exr file: by its name in the "
+                          "environments folder, or (CLI, Python, material files: relative "
+                          "to the file) by its path; "
                           f"'{NO_ENVIRONMENT}' keeps the preset's lights. Default: the "
                           "preset's (none on most; studio on soap-bubble, the films on "
                           f"metals, the stacks and coated-paint), '{MESH_ENVIRONMENT}' on a "

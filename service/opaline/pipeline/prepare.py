@@ -41,6 +41,9 @@ class Context:
     limits: Limits
     meshes: MeshResolver
     environments_dir: Path | None = None
+    # An environment may be a path to a file on this machine (CLI, Python, local batches);
+    # never where a client's request is served.
+    environment_paths: bool = False
     # False where another machine renders (``batch --server``): its folder decides.
     check_environments: bool = True
 
@@ -82,7 +85,8 @@ def scene(request: RenderRequest, named: Preset, context: Context) -> tuple[Pres
     key = preset.scene_key()
     if request.environment is not None and context.check_environments:
         try:
-            path = check_name(request.environment, context.environments_dir)
+            path = check_name(request.environment, context.environments_dir,
+                              context.environment_paths)
         except EnvironmentMapError as exc:
             raise UnknownEnvironment(str(exc)) from None
         if path is not None:

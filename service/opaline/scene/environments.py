@@ -11,7 +11,8 @@ nothing to ship and are the same on every machine:
   a sun 35° up, and a dim ground.
 
 Files (Radiance ``.hdr``, OpenEXR ``.exr``) are read from the environments folder of
-the settings, in the worker processes, by ``environment_files``: bounded before they
+the settings (and, in the CLI, the Python API and local batches, from any path), in
+the worker processes, by ``environment_files``: bounded before they
 are decoded, cleaned (a photographed or rendered map with a few broken pixels still
 lights a scene, and nothing it holds can reach a pixel as NaN or Inf), fitted to the
 sizes lighting uses, and known by their content. ``map_identity`` is what a cache of
@@ -58,34 +59,44 @@ def sky() -> np.ndarray:
     return lit.astype(np.float32)
 
 
-def check_name(name: str, folder: Path | None) -> Path | None:
+def check_name(name: str, folder: Path | None, paths: bool = False) -> Path | None:
     """The file ``name`` means (None for a built-in one), without reading it: the HTTP
-    process checks names, workers read files."""
+    process checks names, workers read files. ``paths``: this machine's own tools (CLI,
+    Python, local batches) also take a path to an .hdr/.exr file, after the folder's
+    names; the service never does, so no client can name a file outside the folder."""
     if name in BUILTIN or name == NO_ENVIRONMENT:
         return None
     if folder is not None and Path(name).name == name and name.lower().endswith(SUFFIXES):
         path = Path(folder) / name
         if path.is_file():
             return path
+    if paths and name.lower().endswith(SUFFIXES):
+        path = Path(name).expanduser()
+        if path.is_file():
+            return path.resolve()
+        if Path(name).name != name:  # meant as a path: say so, as a missing mesh does
+            raise EnvironmentMapError(f"environment={name!r}: no such file")
     # A path is not a name: a file is named as it is in the folder (which the message
     # names by its setting: the CLI user whose path was refused has to know where it goes).
     where = ("the environments folder (OPALINE_ENVIRONMENTS_DIR)" if folder is not None
              else "an environments folder, and OPALINE_ENVIRONMENTS_DIR names none here")
+    files = f"an .hdr/.exr file's path or the name of one in {where}" if paths else \
+        f"the name of an .hdr/.exr file of {where}"
     raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, neutral, "
-                              f"sky, none, or the name of an .hdr/.exr file of {where}")
+                              f"sky, none, or {files}")
 
 
-def map_identity(name: str, folder: Path | None) -> tuple[object, ...]:
-    """What a cache of maps is keyed by: the name, and for a file its size and time."""
-    path = check_name(name, folder)
+def map_identity(name: str, folder: Path | None, paths: bool = False) -> tuple[object, ...]:
+    """What a cache of maps is keyed by: the name, and for a file its path, size and time."""
+    path = check_name(name, folder, paths)
     if path is None:
         return (name,)
     stat = path.stat()
-    return (name, str(folder), stat.st_size, stat.st_mtime_ns)
+    return (name, str(path), stat.st_size, stat.st_mtime_ns)
 
 
-def resolve_map(name: str, folder: Path | None) -> np.ndarray:
-    path = check_name(name, folder)
+def resolve_map(name: str, folder: Path | None, paths: bool = False) -> np.ndarray:
+    path = check_name(name, folder, paths)
     if path is not None:
         return fit(read_file(path))
     if name == "studio":
@@ -98,12 +109,13 @@ _lights: OrderedDict[tuple[object, ...], tuple[np.ndarray, np.ndarray]] = Ordere
 
 
 def environment_lights(name: str, count: int, rotation_deg: float = 0.0, intensity: float = 1.0,
-                       folder: Path | None = None) -> tuple[np.ndarray, np.ndarray]:
+                       folder: Path | None = None,
+                       paths: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(K, 3) directions toward the lights and (K, 3) irradiances, rotated about +y by
     ``rotation_deg`` (the environment turns, the object stays) and scaled by ``intensity``."""
-    key = (*map_identity(name, folder), count)
+    key = (*map_identity(name, folder, paths), count)
     if key not in _lights:
-        _lights[key] = median_cut(resolve_map(name, folder), count)
+        _lights[key] = median_cut(resolve_map(name, folder, paths), count)
         while len(_lights) > CACHED:
             _lights.popitem(last=False)
     _lights.move_to_end(key)

@@ -15,6 +15,7 @@ class RendererFactory:
     scene_bytes: int = 128 * 1024 * 1024
     target_bytes: int = 256 * 1024 * 1024
     environments_dir: Path | None = None  # the user's environment maps (settings)
+    environment_paths: bool = False  # maps named by a path too (local batches), not served
 
     def __call__(self) -> Any:
         from opaline.gl.buffers import RenderBudgets
@@ -22,7 +23,8 @@ class RendererFactory:
 
         budgets = RenderBudgets(max_programs=self.max_programs, scene_bytes=self.scene_bytes,
                                 target_bytes=self.target_bytes)
-        return Renderer(self.backend, budgets=budgets, environments_dir=self.environments_dir)
+        return Renderer(self.backend, budgets=budgets, environments_dir=self.environments_dir,
+                        environment_paths=self.environment_paths)
 
 
 class ParserOnly:
