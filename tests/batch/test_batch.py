@@ -182,7 +182,7 @@ mu_f = -3
     with Image.open(out / "oil/strong.png") as strong, Image.open(out / "disc-wide.png") as wide:
         assert strong.size == (48, 48) and wide.size == (80, 64)
     items = by_name(summary_of(out))
-    assert "set.manifest.toml[hot]: mu_f=-3 is out of range" in items["hot"]["error"]
+    assert "set.manifest.toml:16: [hot]: mu_f=-3 is out of range" in items["hot"]["error"]
 
 
 def test_sheet_writes_an_index_and_a_grid_image(mixed, backend):

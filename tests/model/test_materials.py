@@ -177,20 +177,48 @@ path = "disc.toml"
 
 
 def test_manifest_entries_fail_one_by_one(tmp_path):
-    """A bad entry fails alone, with the manifest, the entry name and the reason."""
-    manifest = write(tmp_path / "set.manifest.json", json.dumps({"material": [
-        {"name": "good", "mu_f": 1},
-        {"name": "hot", "mu_f": -1},
-        {"name": "../escape", "mu_f": 1},
-        {"mu_f": 1},
-        {"name": "lost", "path": "missing.toml"},
-    ]}))
+    """A bad entry fails alone, with the manifest, the line its entry starts on, the entry
+    name and the reason (one object a line below the array's opening line)."""
+    entries = [{"name": "good", "mu_f": 1}, {"name": "hot", "mu_f": -1},
+               {"name": "../escape", "mu_f": 1}, {"mu_f": 1},
+               {"name": "lost", "path": "missing.toml"}]
+    text = '{"defaults": {"width": 64, "environment": "[{\\" ]"},\n "material": [\n' + ",\n".join(
+        json.dumps(entry) for entry in entries) + "\n]}\n"
+    manifest = write(tmp_path / "set.manifest.json", text)
     good, hot, escape, unnamed, lost = collect([manifest])
     assert good.error is None
-    assert f"{manifest}[hot]: mu_f=-1 is out of range" in hot.error
-    assert "must be letters" in escape.error and escape.request is None
-    assert "name=None" in unnamed.error
+    assert f"{manifest}:4: [hot]: mu_f=-1 is out of range" in hot.error and hot.line == 4
+    assert "must be letters" in escape.error and escape.request is None and escape.line == 5
+    assert "name=None" in unnamed.error and unnamed.line == 6
     assert "cannot read" in lost.error
+    flat = write(tmp_path / "flat.manifest.json", json.dumps({"material": entries[:2]}))
+    assert [item.line for item in collect([flat])] == [None, 1]
+
+
+def test_manifest_toml_errors_name_the_entry_line(tmp_path):
+    manifest = write(tmp_path / "set.manifest.toml",
+                     '[defaults]\nwidth = 64\n\n[[material]]\nname = "a"\nmu_f = 1\n\n'
+                     '[[material]]\nname = "b"\nmu_f = -2\n')
+    a, b = collect([manifest])
+    assert a.error is None and b.line == 8
+    assert b.error.startswith(f"{manifest}:8: [b]: mu_f=-2 is out of range")
+
+
+def test_manifest_files_are_relative_to_who_wrote_them(tmp_path, monkeypatch):
+    """A mesh or environment map written in a manifest is relative to the manifest; one
+    written in a material file it names, relative to that file (as when it is rendered
+    alone), wherever the batch runs."""
+    write(tmp_path / "meshes/m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    write(tmp_path / "sub/maps/room.hdr", "")
+    write(tmp_path / "sub/disc.toml", 'preset = "cd-rom"\nenvironment = "maps/room.hdr"\n')
+    manifest = write(tmp_path / "set.manifest.toml",
+                     '[defaults]\nmesh = "meshes/m.obj"\n\n[[material]]\nname = "a"\n\n'
+                     '[[material]]\npath = "sub/disc.toml"\n')
+    monkeypatch.chdir("/")
+    a, disc = collect([manifest])
+    assert a.request.mesh == disc.request.mesh == str(tmp_path / "meshes/m.obj")
+    assert disc.request.environment == str(tmp_path / "sub/maps/room.hdr")
+    assert a.request.environment is None
 
 
 def test_manifest_with_unknown_top_level_key_fails_as_a_whole(tmp_path):

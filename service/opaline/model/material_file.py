@@ -119,18 +119,25 @@ def load_material(path: Path | str, overrides: dict[str, Any] | None = None) -> 
         raise MaterialError(f"{path}: empty material file: expected fields such as "
                             'preset = "cd-rom" (see `opaline schema`)', path)
     own = set(fields) - set(overrides or {})
+    fields = files_beside(path, fields)
     fields.update(overrides or {})
-    if isinstance(fields.get("mesh"), str) and "mesh" in own:
-        # A mesh written in the file is relative to the file, as an editor sees it.
-        fields["mesh"] = str(path.parent / Path(fields["mesh"]).expanduser())
-    if isinstance(fields.get("environment"), str) and "environment" in own:
-        fields["environment"] = environment_beside(path, fields["environment"])
     try:
         return validate(fields, set(fields) - own)
     except ValidationError as exc:
         line = _first_line(exc, text, own, path.suffix.lower() == ".json")
         raise MaterialError(f"{at(path, line)}: " + "; ".join(describe_errors(exc)), path,
                             line) from None
+
+
+def files_beside(path: Path, fields: dict[str, Any]) -> dict[str, Any]:
+    """``fields`` as written in the file at ``path``, its mesh and environment files found
+    as an editor sees them: relative to that file, not to where the command runs."""
+    found = dict(fields)
+    if isinstance(found.get("mesh"), str):
+        found["mesh"] = str(path.parent / Path(found["mesh"]).expanduser())
+    if isinstance(found.get("environment"), str):
+        found["environment"] = environment_beside(path, found["environment"])
+    return found
 
 
 def environment_beside(path: Path, environment: str) -> str:

@@ -23,13 +23,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from opaline.model.manifest_lines import entry_lines
 from opaline.model.material_file import (
     SCHEMA_KEY,
     SUFFIXES,
     MaterialError,
+    files_beside,
     load_material,
     parse_request,
     read_table,
+    read_text_table,
 )
 from opaline.model.params import RenderRequest
 
@@ -76,11 +79,16 @@ def material_items(path: Path, name: str, overrides: dict[str, Any]) -> list[Ite
 def manifest_items(path: Path, prefix: str, overrides: dict[str, Any]) -> list[Item]:
     """Every entry of a manifest; entry names are prefixed with ``prefix``."""
     try:
-        data = read_table(path)
+        data, text = read_text_table(path)
         entries, defaults = _manifest_parts(path, data)
     except MaterialError as exc:
         return [failed(prefix + path.name.split(".")[0], str(path), exc, path)]
-    return [_entry_item(path, index, entry, defaults, prefix, overrides)
+    defaults = files_beside(path, defaults)
+    lines = entry_lines(text, path.suffix.lower() == ".json")
+    if len(lines) != len(entries):  # written in a form not scanned for: no lines
+        lines = []
+    return [_entry_item(path, index, entry, defaults, prefix, overrides,
+                        lines[index] if lines else None)
             for index, entry in enumerate(entries)]
 
 
@@ -99,11 +107,16 @@ def _manifest_parts(path: Path, data: dict[str, Any]) -> tuple[list[Any], dict[s
 
 
 def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any], prefix: str,
-                overrides: dict[str, Any]) -> Item:
-    where = f"{manifest}[material {index + 1}]"
+                overrides: dict[str, Any], line: int | None) -> Item:
+    """Entry ``index`` of a manifest, written from ``line`` (None: not known); its errors
+    start ``FILE:LINE:`` as a material file's do, for editors and CI annotations."""
+    def at_entry(label: str) -> str:
+        return f"{manifest}[{label}]" if line is None else f"{manifest}:{line}: [{label}]"
+
+    where = at_entry(f"material {index + 1}")
     if not isinstance(entry, dict):
         return Item(f"{prefix}#{index + 1}", where, error=f"{where}: expected a table",
-                    file=str(manifest))
+                    file=str(manifest), line=line)
     fields = {k: v for k, v in entry.items() if k not in ENTRY_KEYS}
     ref = entry.get("path")
     name = entry.get("name")
@@ -113,8 +126,8 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any]
         shown = f"#{index + 1}" if name is None else str(name)
         return Item(prefix + shown, where, error=f"{where}: name={name!r} must be letters, digits, "
                     "'.', '_', '-' and '/' separators (a relative output name)",
-                    file=str(manifest))
-    where = f"{manifest}[{name}]"
+                    file=str(manifest), line=line)
+    where = at_entry(name)
     try:
         merged = dict(defaults)
         if ref is not None:
@@ -124,13 +137,16 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any]
             if not table:
                 raise MaterialError(f"{where}: {ref} is an empty material file",
                                     manifest.parent / ref)
-            merged.update(table)
-            where = f"{manifest}[{name}] ({ref})"
-        merged.update(fields)
+            merged.update(files_beside(manifest.parent / ref, table))
+            where = f"{at_entry(name)} ({ref})"
+        merged.update(files_beside(manifest, fields))
         merged.update(overrides)
         request = parse_request(merged, where, lax=overrides)
     except MaterialError as exc:
-        return failed(prefix + name, where, exc, manifest)
+        item = failed(prefix + name, where, exc, manifest)
+        if item.line is None and item.file == str(manifest):
+            item.line = line
+        return item
     return Item(prefix + name, where, request, file=str(manifest))
 
 
