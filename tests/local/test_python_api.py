@@ -49,6 +49,35 @@ def test_importing_opaline_stays_light():
     assert result.returncode == 0, result.stderr
 
 
+def test_a_thread_that_ends_releases_its_context(backend):
+    """A thread that rendered and ended without close() gave its GL context back (each
+    such thread kept ~6 MB for the life of the process); one that closed is not released
+    twice; the main thread's renderer outlives the others. In a process of its own: the
+    contexts are made and released as a user's threads would."""
+    code = f"""
+import threading
+from opaline.local import api
+SMALL = {{"preset": "sphere", "width": 16, "height": 16, "quality": "draft"}}
+seen = []
+def work(closes):
+    api.render(SMALL, backend={backend!r})
+    seen.append(api.renderer({backend!r}).renderer.ctx)
+    if closes:
+        api.close()
+api.render(SMALL, backend={backend!r})
+for closes in (False, True, False):
+    thread = threading.Thread(target=work, args=(closes,))
+    thread.start()
+    thread.join()
+assert [type(ctx.mglo).__name__ for ctx in seen] == ["InvalidObject"] * 3
+assert type(api.renderer({backend!r}).renderer.ctx.mglo).__name__ == "Context"
+assert api.render(SMALL, backend={backend!r}).startswith(b"\\x89PNG")
+"""
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+
+
 def test_unknown_attribute_of_opaline_is_an_attribute_error():
     """The lazy `opaline.__getattr__` still raises AttributeError for names it does not know."""
     import opaline

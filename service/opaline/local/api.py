@@ -7,7 +7,7 @@
 
 Each thread gets its own ``pipeline.LocalRenderer`` (a GL context is current
 on one thread only), made on first use and kept for the next call; ``close()``
-releases the calling thread's renderer. Invalid requests raise ``RequestError``
+releases the calling thread's renderer, and a thread that ends releases its own. Invalid requests raise ``RequestError``
 (one line per field: name, value, allowed range); an unknown preset raises
 ``presets.UnknownPreset``; a request over the cost budget ``request.CostError``.
 """
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import threading
+import weakref
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -81,6 +82,11 @@ def renderer(backend: BackendName | None = None) -> LocalRenderer:
     if found is None:
         found = LocalRenderer(backend)
         _local.renderer, _local.backend = found, backend
+        # Released when the thread ends, should it never call close(): the thread's locals
+        # are dropped on that thread as it exits, where the context is current. Not at the
+        # interpreter's exit, which runs on the main thread, not the context's.
+        _local.ends, _local.release = (end := _ThreadEnd()), weakref.finalize(end, found.close)
+        _local.release.atexit = False
     return found
 
 
@@ -97,8 +103,13 @@ def render_array(
 
 
 def close() -> None:
-    """Release the calling thread's renderer and its GL context."""
-    found = getattr(_local, "renderer", None)
-    _local.renderer = _local.backend = None
-    if found is not None:
-        found.close()
+    """Release the calling thread's renderer and its GL context (also done when the
+    thread ends)."""
+    release = getattr(_local, "release", None)
+    _local.renderer = _local.backend = _local.ends = _local.release = None
+    if release is not None:
+        release()  # at most once: a finalizer called is dead
+
+
+class _ThreadEnd:
+    """Held only in a thread's locals: collected when the thread ends."""
