@@ -12,6 +12,7 @@ from urllib.parse import parse_qs, urlsplit
 import pytest
 
 from bench_metrics import load_bench
+from opaline.model.tiers import TIERS
 from opaline.server.localserver import LocalServer, ServerError, loopback_env
 
 CHROMIUM = Path("/usr/bin/chromium")
@@ -134,6 +135,11 @@ def test_page_loads_with_controls_from_the_schema(page):
     assert page.locator("#in-albedo-color").count() == 1
     assert page.locator("#in-tangent_axis-color").count() == 0
     assert page.input_value("#in-tangent_axis-1") == ""
+    # An unset tier field's slider stands at the tier's value (it stood at the range's
+    # minimum, 1 sample, where standard takes 4), and says so.
+    standard = TIERS["standard"].samples
+    assert page.get_attribute("#rng-samples", "aria-valuetext") == f"tier's value: {standard}"
+    assert page.input_value("#rng-samples") != page.get_attribute("#rng-samples", "min")
 
 
 def test_preset_and_slider_change_the_preview(page):

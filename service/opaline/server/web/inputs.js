@@ -72,11 +72,14 @@ export function numberControl(spec) {
       input.placeholder = blank ? (isTier(name) ? 'tier' : 'preset') : '';
       const tier = blank && isTier(name) ? tierValue(name) : undefined;
       input.title = tier === undefined ? '' : `the tier's value: ${tier}`;
+      // An unset tier field's slider stands at the tier's value, not at its range's end.
+      const tierNumber = typeof tier === 'number' ? tier : undefined;
       if (range && source !== range) {
-        const shown = blank ? (LIGHT_FALLBACK[name] ?? spec.min) : value;
+        const shown = blank ? (tierNumber ?? LIGHT_FALLBACK[name] ?? spec.min) : value;
         range.value = String(Math.round(scale.toPos(Number(shown))));
       }
-      if (range) range.setAttribute('aria-valuetext', blank ? 'preset value' : String(value));
+      const unsetText = tierNumber === undefined ? 'preset value' : `tier's value: ${tierNumber}`;
+      if (range) range.setAttribute('aria-valuetext', blank ? unsetText : String(value));
       shell.wrap.classList.toggle('unset', blank);
     },
   };
