@@ -48,6 +48,19 @@ def test_a_map_over_the_limit_is_refused_before_it_is_decoded(tmp_path, monkeypa
         assert "8192 × 4096" in message and "scale it down" in message
 
 
+def test_a_multi_part_exr_is_refused_before_any_part_is_decoded(tmp_path, monkeypatch):
+    """Only the first part's window was checked, and every part was decoded: a 16384²
+    second part behind a 64 × 32 first one (600 KB of file) cost a worker 530 MB."""
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
+              "displayWindow": ((0, 0), (99, 99))}
+    parts = [OpenEXR.Part(dict(header), {"RGB": np.ones((32, 64, 3), np.float32)}, name="small"),
+             OpenEXR.Part(dict(header), {"Y": np.zeros((100, 100), np.float16)}, name="more")]
+    with OpenEXR.File(parts) as file:
+        file.write(str(tmp_path / "parts.exr"))
+    with pytest.raises(environment_files.EnvironmentMapError, match="2 parts"):
+        environment_files.read_file(tmp_path / "parts.exr")
+
+
 @pytest.mark.parametrize("shape", [(1, 1), (1, 2), (2, 4), (2, 512), (64, 128), (128, 256),
                                    (1100, 2300), (3000, 100), (4, 20000)])
 def test_a_uniform_map_lights_alike_at_any_size(tmp_path, shape):

@@ -27,6 +27,7 @@ import logging
 import math
 import re
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 
@@ -38,7 +39,11 @@ MAX_RADIANCE = 1e10
 MAX_FILE_PIXELS = 8192 * 4096  # an 8k HDRI: 400 MB as float32 RGB
 MAX_WIDTH = 2048  # 0.18° a texel: finer than a 256² preview's pixel at 40°
 MIN_WIDTH = 128
-RADIANCE_SIZE = re.compile(rb"^[-+][XY] (\d+) [-+][XY] (\d+)$")
+# sscanf's "-Y %d +X %d": a space matches any run of white space, %d skips it too.
+RADIANCE_SIZE = re.compile(rb"-Y\s*([-+]?\d+)\s*\+X\s*([-+]?\d+)")
+RADIANCE_SIGNATURES = (b"#?RGBE", b"#?RADIANCE")
+RADIANCE_FORMAT = b"FORMAT=32-bit_rle_rgbe\n"
+MAX_RADIANCE_HEADER = 1 << 16
 
 log = logging.getLogger(__name__)
 
@@ -66,6 +71,8 @@ def read_file(path: Path) -> np.ndarray:
 
 
 def _check_size(width: int, height: int) -> None:
+    if width <= 0 or height <= 0:
+        raise ValueError(f"{width} × {height} texels: no image")
     if width * height > MAX_FILE_PIXELS:
         raise ValueError(f"{width} × {height} texels is over the {MAX_FILE_PIXELS:,} this "
                          f"service reads (8192 × 4096): scale it down ({MAX_WIDTH} × "
@@ -76,6 +83,11 @@ def _read_exr(path: Path) -> np.ndarray:
     import OpenEXR
 
     with OpenEXR.File(str(path), header_only=True) as header:
+        # Every part is decoded below, and a map is one image: a second part of 16384²
+        # behind a small first one was read whole (600 KB of file, 530 MB in the worker).
+        if len(header.parts) != 1:
+            raise ValueError(f"{len(header.parts)} parts: an environment map is one image, "
+                             "a single-part file")
         (x0, y0), (x1, y1) = header.header()["dataWindow"]
         _check_size(int(x1) - int(x0) + 1, int(y1) - int(y0) + 1)
     with OpenEXR.File(str(path)) as exr:
@@ -91,24 +103,50 @@ def _read_exr(path: Path) -> np.ndarray:
 
 def _read_radiance(path: Path) -> np.ndarray:
     with open(path, "rb") as stream:
-        head = stream.read(1 << 16)
-    if not head.startswith(b"#?"):  # "#?RADIANCE", "#?RGBE": OpenCV read a PNG named .hdr
-        raise ValueError("not a Radiance .hdr image (it does not begin with '#?')")
-    for line in head.split(b"\n")[1:]:
-        found = RADIANCE_SIZE.match(line.strip())
-        if found:
-            _check_size(int(found.group(2)), int(found.group(1)))
-            break
+        width, height = radiance_size(stream)
+    _check_size(width, height)
     import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
 
     try:
         decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
         raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
-    if decoded is None:
+    if decoded is None or decoded.shape[:2] != (height, width):
         raise ValueError("not a Radiance .hdr image")
     image: np.ndarray = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
     return image
+
+
+def radiance_size(stream: BinaryIO) -> tuple[int, int]:
+    """(width, height) of a Radiance header, read as OpenCV's reader reads it (rgbe.cpp,
+    ``RGBE_ReadHeader``): lines as ``fgets`` gives them into 128 bytes, each a C string, up
+    to ``FORMAT=32-bit_rle_rgbe``, a blank line, then ``sscanf("-Y %d +X %d")``. Anything
+    that reader might take differently is refused (a ValueError) before it decodes: a
+    size line with two spaces, or after 64 KiB of comments, passed a stricter scan that
+    found none, and an 8192 × 16384 map was decoded (4 GB in the worker)."""
+    signature = stream.read(len(RADIANCE_SIGNATURES[1]))
+    if not signature.startswith(RADIANCE_SIGNATURES):  # OpenCV read a PNG named .hdr
+        raise ValueError("not a Radiance .hdr image (it does not begin with '#?RADIANCE' "
+                         "or '#?RGBE')")
+    stream.seek(0)
+    line = _c_line(stream)
+    while line != RADIANCE_FORMAT:
+        if line[:1] in (b"", b"\n") or stream.tell() > MAX_RADIANCE_HEADER:
+            raise ValueError("no FORMAT=32-bit_rle_rgbe line in its first "
+                             f"{MAX_RADIANCE_HEADER // 1024} KiB of header")
+        line = _c_line(stream)
+    if _c_line(stream) != b"\n":
+        raise ValueError("no blank line after its FORMAT line")
+    found = RADIANCE_SIZE.match(_c_line(stream))
+    if not found or int(found.group(1)) <= 0 or int(found.group(2)) <= 0:
+        raise ValueError("no '-Y height +X width' line after its FORMAT line and a blank one "
+                         "(other orientations are not read)")
+    return int(found.group(2)), int(found.group(1))
+
+
+def _c_line(stream: BinaryIO) -> bytes:
+    """What ``fgets(buf, 128, f)`` leaves in ``buf``, up to its first NUL."""
+    return stream.readline(127).split(b"\0", 1)[0]
 
 
 def sanitised(name: str, radiance: np.ndarray) -> np.ndarray:
