@@ -124,6 +124,11 @@ def test_a_reupload_whose_check_cannot_run_keeps_the_stored_copy(backend, tmp_pa
             refused = hurried.post("/v1/meshes", content=data)
             assert refused.status_code == 422 and refused.json()["error"] == "too_slow"
             assert refused.json()["detail"][0].startswith("checking this mesh file is")
+            # A render's refusal names the fields the request set that drive its time.
+            slow = hurried.get(f"/v1/render?preset=sphere&environment_samples=64&{SMALL}")
+            assert slow.status_code == 422 and slow.json()["error"] == "too_slow"
+            assert "lower environment_samples=64" in slow.json()["detail"][0]
+            assert slow.json()["fields"][0]["field"] == "environment_samples"
         assert sorted(p.name for p in tmp_path.iterdir()) == [f"{mesh_id}.mesh"]
         image = client.get(f"/v1/render?preset=sphere&mesh={mesh_id}&{SMALL}")
         assert image.status_code == 200, image.text

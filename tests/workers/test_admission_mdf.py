@@ -43,9 +43,11 @@ def test_the_calibration_times_the_plot_and_predicts_it_from_above(renderer):
     found.calibrate(json.dumps({**SLOW_PRESET, "timings": {MDF_LABEL: timings}}).encode())
     task = MdfTask(Material(mdf="multipeak"), 512, "png", 128)
     task.run(renderer, lambda: False)  # compiled outside the timing
-    start = time.perf_counter()
-    task.run(renderer, lambda: False)
-    took = time.perf_counter() - start
+    took = float("inf")  # the least of three: one timing on a shared machine can stall
+    for _ in range(3):
+        start = time.perf_counter()
+        task.run(renderer, lambda: False)
+        took = min(took, time.perf_counter() - start)
     predicted = found.predict(*task.units())
     # From above (its safety factor), and not hundreds of times over as before.
     assert took < predicted < 40 * took + 0.5

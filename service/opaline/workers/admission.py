@@ -35,7 +35,7 @@ from __future__ import annotations
 import json
 import threading
 from collections import OrderedDict
-from collections.abc import Hashable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -118,9 +118,11 @@ class CostModel:
                 self._warm.popitem(last=False)
 
     def predict(self, label: str, units: float, wavelengths: int, extra_s: float = 0.0,
-                light_load: float = 1.0) -> float:
+                light_load: float = 1.0, read_s: float = 0.0) -> float:
         """Predicted seconds for a task (safety factor included); ``light_load``: what a
-        sample shades over its preset's lights, scaling the units past the calibration's."""
+        sample shades over its preset's lights, scaling the units past the calibration's;
+        ``read_s``: a mesh file's read, at the slowest format's rate already, so without
+        the safety factor (with it, a 2M-triangle scan was refused at every size)."""
         if label == CHECK_LABEL:
             return check_cost_s(units)
         with self._lock:
@@ -129,7 +131,7 @@ class CostModel:
         growth = (1.0 + wavelengths / GROWTH_W) / (1.0 + self.calibration_wavelengths / GROWTH_W)
         spectral = found.per_wavelength * wavelengths * growth
         estimate = self.overhead_s + extra_s + found.per_unit_s * units * (1.0 + spectral)
-        return SAFETY * estimate * self.pace.factor()
+        return (SAFETY * estimate + read_s) * self.pace.factor()
 
     def observe(self, task: Any, predicted: float, seconds: float) -> None:
         """A render predicted at ``predicted`` (``predict_task``) took ``seconds``."""
@@ -202,11 +204,11 @@ def shading_index(iridescence: str, orders: int, stack_pairs: int = 0,
     return coat * (1.25 * (1 + stack_pairs) if iridescence == "thin-film" else 1.0)
 
 
-def mesh_cost_s(size_bytes: int, max_triangles: int, passes: int) -> float:
-    """Seconds a render spends on a mesh file besides shading: its parse (a worker keeps a
-    few parsed, but admission cannot know which) and its triangles drawn in every pass."""
+def mesh_cost_s(size_bytes: int, max_triangles: int, passes: int) -> tuple[float, float]:
+    """Seconds a render spends on a mesh file besides shading: its read (a worker keeps a
+    few read, but admission cannot know which) and its triangles drawn in every pass."""
     triangles = min(max_triangles, size_bytes // MIN_BYTES_PER_TRIANGLE)
-    return CHECK_S_PER_BYTE * size_bytes + TRIANGLE_PASS_S * triangles * passes
+    return CHECK_S_PER_BYTE * size_bytes, TRIANGLE_PASS_S * triangles * passes
 
 
 def check_cost_s(size_bytes: float) -> float:
@@ -221,20 +223,25 @@ CHECK_ADVICE = ("send a smaller file (fewer triangles; GLB or binary PLY read fa
 
 
 def admit(predicted: float, workers: int, running: Sequence[float], queued: Sequence[float],
-          queue_size: int, deadline_s: float, label: str = "") -> Exception | None:
+          queue_size: int, deadline_s: float, label: str = "",
+          task: object = None) -> Exception | None:
     """Why a job predicted to take ``predicted`` seconds cannot be taken now, or None.
 
     ``running``: the predicted seconds left of each job being rendered; ``queued``:
     the predictions of the jobs waiting. The work ahead is shared by the workers. ``label``:
-    the job's, so that a refusal's advice fits it (a mesh check is no render)."""
+    the job's, so that a refusal's advice fits it (a mesh check is no render); ``task``:
+    the job's, whose own ``advice()`` (what to lower, the request fields it names) a
+    refusal gives where it has one."""
     if not workers:
         return Unavailable("no render worker has a GL context (the server log says why)")
     if predicted > deadline_s:
-        what, advice = {CHECK_LABEL: ("checking this mesh file", CHECK_ADVICE),
+        what, default = {CHECK_LABEL: ("checking this mesh file", CHECK_ADVICE),
                         MDF_LABEL: ("this plot", PLOT_ADVICE)}.get(
                             label, ("this request", RENDER_ADVICE))
+        advice: Callable[[float], tuple[str, list[str]]] | None = getattr(task, "advice", None)
+        advice_text, fields = advice(predicted) if advice is not None else (default, [])
         return TooSlow(f"{what} is predicted to take {predicted:.1f} s, over the "
-                       f"{deadline_s:g} s limit: {advice}")
+                       f"{deadline_s:g} s limit: {advice_text}", fields)
     backlog = (sum(running) + sum(queued)) / workers
     if len(queued) >= queue_size or backlog + predicted > deadline_s:
         return Overloaded(f"{len(queued)} jobs are waiting, about {backlog:.1f} s of work",

@@ -18,9 +18,17 @@ class Overloaded(PublicError):
 
 
 class TooSlow(PublicError, ValueError):
-    """The job alone is predicted to take longer than the deadline allows (422)."""
+    """The job alone is predicted to take longer than the deadline allows (422);
+    ``fields``: the request's fields that its advice names."""
 
     status, reason = 422, "too_slow"
+
+    def __init__(self, message: str, fields: list[str] | None = None) -> None:
+        super().__init__(message)
+        self.fields = fields or []
+
+    def field_problems(self) -> list[dict[str, str]]:
+        return [{"field": name, "message": str(self)} for name in self.fields]
 
 
 class DeadlineExceeded(PublicError):

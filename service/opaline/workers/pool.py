@@ -130,7 +130,7 @@ class WorkerPool:
         # A worker being replaced counts: its job waits the second a new process takes.
         workers = sum(slot.state in ("ready", "busy", "starting") for slot in self.slots)
         refusal = admit(job.predicted, workers, running, [j.predicted for j in self._queue],
-                        self.queue_size, self.deadline_s, job.label)
+                        self.queue_size, self.deadline_s, job.label, job.task)
         if refusal is not None:
             self.counters["refused_too_slow" if isinstance(refusal, TooSlow)
                           else "refused_queue"] += 1

@@ -20,9 +20,12 @@ from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared
 from opaline.pipeline.produce import produce
 from opaline.scene.environments import BUILTIN
-from opaline.workers.admission import MDF_LABEL, mesh_cost_s, shading_index
+from opaline.workers.admission import MDF_LABEL, RENDER_ADVICE, mesh_cost_s, shading_index
 
 StopCheck = Callable[[], bool]
+# The fields a request sets that drive a render's time, as a refusal names them.
+COST_FIELDS = ("environment_samples", "environment_lights", "samples", "wavelengths", "width",
+               "height", "grating_orders", "film_stack_pairs")
 
 
 def no_meshes(request: RenderRequest, preset: Preset) -> Preset:
@@ -93,7 +96,7 @@ class ImageTask:
                 job.environment, job.environment_lights, job.environment_samples,
                 job.environment_background, material)
 
-    def units(self) -> tuple[str, float, int, float, float]:
+    def units(self) -> tuple[str, float, int, float, float, float]:
         job, preset = self.prepared.job, self.prepared.preset
         units = float(job.width * job.height * job.samples)
         # Calibrated on the preset's own material: a costlier source or more orders scale
@@ -106,7 +109,8 @@ class ImageTask:
                                      own.get("grating_orders") or 3,
                                      own.get("film_stack_pairs") or 0,
                                      (own.get("coat_weight") or 0.0) > 0.0))
-        return self.cost_label(), units, job.wavelengths, self._mesh_s(), self.light_load()
+        read_s, draw_s = self._mesh_s()
+        return self.cost_label(), units, job.wavelengths, draw_s, self.light_load(), read_s
 
     def light_load(self) -> float:
         """What a sample shades over its preset's own lights: 1, or an environment's light
@@ -116,14 +120,32 @@ class ImageTask:
             return 1.0
         return light_equivalents(job) / len(self.prepared.preset.lights)
 
-    def _mesh_s(self) -> float:
+    def advice(self, predicted: float) -> tuple[str, list[str]]:
+        """What a refusal as too slow (``predicted`` seconds) advises, and the request fields
+        it names: those of the cost's drivers the request set (their values), and the mesh
+        file where it is half the time or more (a 2M-triangle scan's refusal named only
+        width and height, which could not help)."""
+        request = self.prepared.request
+        named = [name for name in COST_FIELDS if name in request.model_fields_set]
+        lower = ", ".join(f"{name}={getattr(request, name)}" for name in named)
+        advice = (f"lower {lower} (or width, height, samples, wavelengths, or the quality)"
+                  if named else RENDER_ADVICE)
+        read_s, draw_s = self._mesh_s()
+        if read_s + draw_s >= 0.5 * predicted:
+            advice = (f"its mesh file alone takes about {read_s + draw_s:.1f} s (send one with "
+                      f"fewer triangles; GLB or binary PLY read fastest); or {advice}")
+            named.append("mesh")
+        return advice, named
+
+    def _mesh_s(self) -> tuple[float, float]:
+        """Seconds the request's mesh file costs a render: its read, and its drawing."""
         args = self.prepared.preset.geometry.args
         if self.prepared.preset.geometry.kind != "file":
-            return 0.0
+            return 0.0, 0.0
         try:
             size = os.path.getsize(args["path"])
         except OSError:
-            return 0.0
+            return 0.0, 0.0
         passes = self.job.samples if self.job.wavelengths or self.job.samples % 4 else max(
             1, self.job.samples // 4)
         return mesh_cost_s(size, int(args.get("max_triangles", 2_000_000)), passes)
