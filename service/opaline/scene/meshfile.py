@@ -15,6 +15,7 @@ are ``tangents.tangent_frame``.
 
 from __future__ import annotations
 
+import gc
 import importlib
 import io
 import re
@@ -141,6 +142,18 @@ def build_mesh(data: bytes, fmt: str, field: str = "auto",
     file (``up`` "z") is turned a quarter about x, (x, y, z) → (x, z, −y), a rotation (it
     keeps the winding), so that its +z is up before its normals, tangents and bounds."""
     loaded = _parse(data, fmt)
+    try:
+        return _checked_mesh(loaded, fmt, field, axis, max_triangles, up)
+    finally:
+        # trimesh's objects hold reference cycles (its caches), so a parse's intermediates
+        # waited for the collector: ~300 MB of a 2M-triangle scan, which took its worker
+        # past WORKER_MAX_RSS_MB, recycled after every render of it, each reading it again.
+        del loaded
+        gc.collect()
+
+
+def _checked_mesh(loaded: trimesh.Trimesh, fmt: str, field: str, axis: Sequence[float],
+                  max_triangles: int, up: str) -> tuple[Mesh, MeshSummary]:
     faces = np.asarray(loaded.faces, dtype=np.int64)
     positions = np.asarray(loaded.vertices, dtype=np.float64)
     if up == "z":
