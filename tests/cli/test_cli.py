@@ -102,6 +102,15 @@ def test_unknown_field_is_explained(capsys, tmp_path):
     assert "mu_f" in err and "theta1" in err
 
 
+def test_a_second_preset_is_one_line_not_a_traceback(capsys, tmp_path):
+    """`render cd-rom --set preset=nacre` raised TypeError (two presets for one request) and
+    exited 1 with a traceback; the same preset again is no conflict."""
+    out = tmp_path / "x.png"
+    code, _, err = run(capsys, "render", "cd-rom", "--set", "preset=nacre", "-o", str(out))
+    assert code == 2 and "Traceback" not in err and not out.exists()
+    assert "--set preset=nacre" in err and "'cd-rom'" in err and len(err.splitlines()) == 1
+
+
 def test_bad_size_is_explained(capsys, tmp_path):
     """`--size big` exits 2 with the expected form."""
     code, _, err = run(capsys, "render", "cd-rom", "--size", "big", "-o", str(tmp_path / "x.png"))

@@ -99,8 +99,11 @@ def load_request(source: str, fields: dict[str, Any]) -> RenderRequest:
             return load_material(source, fields)
         except MaterialError as exc:
             raise CliError(str(exc)) from None
+    if "preset" in fields and fields["preset"] != source:
+        raise CliError(f"--set preset={fields['preset']}: the preset is the command's first "
+                       f"argument, here {source!r}; name {fields['preset']!r} there instead")
     try:
-        return RenderRequest(preset=source, **fields)
+        return RenderRequest(**{**fields, "preset": source})
     except ValidationError as exc:
         raise CliError("; ".join(describe_errors(exc))) from None
 
