@@ -7,9 +7,12 @@ import re
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from opaline.cli.main import main
 from opaline.model import materials
+from opaline.model.manifest_lines import entry_lines
 from opaline.model.materials import MaterialError, collect, load_material, material_schema
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -190,7 +193,7 @@ def test_manifest_entries_fail_one_by_one(tmp_path):
     assert f"{manifest}:4: [hot]: mu_f=-1 is out of range" in hot.error and hot.line == 4
     assert "must be letters" in escape.error and escape.request is None and escape.line == 5
     assert "name=None" in unnamed.error and unnamed.line == 6
-    assert "cannot read" in lost.error
+    assert "no such material file" in lost.error and lost.line == 7
     flat = write(tmp_path / "flat.manifest.json", json.dumps({"material": entries[:2]}))
     assert [item.line for item in collect([flat])] == [None, 1]
 
@@ -202,6 +205,41 @@ def test_manifest_toml_errors_name_the_entry_line(tmp_path):
     a, b = collect([manifest])
     assert a.error is None and b.line == 8
     assert b.error.startswith(f"{manifest}:8: [b]: mu_f=-2 is out of range")
+
+
+def test_manifest_lines_in_every_form_an_entry_takes(tmp_path):
+    """An inline TOML array of tables, a JSON entry that is no object, and an entry whose
+    material file is missing: each error starts FILE:LINE: at its entry (a review found
+    them without lines, as `file[b]:`)."""
+    inline = write(tmp_path / "i.manifest.toml",
+                   'defaults = {width = 64}\nmaterial = [\n  {name = "a", preset = "cd-rom"},'
+                   '  # a comment, "quoted" [and bracketed]\n  {name = "b", mu_f = -2},\n]\n')
+    a, b = collect([inline])
+    assert a.error is None and b.line == 4 and b.error.startswith(f"{inline}:4: [b]: mu_f=-2")
+    mixed = write(tmp_path / "m.manifest.json",
+                  '{\n "material": [\n  {"name": "a"},\n  42,\n  {"name": "c", "mu_f": -1}\n ]}\n')
+    a, number, c = collect([mixed])
+    assert (a.error, number.line, c.line) == (None, 4, 5)
+    assert number.error == f"{mixed}:4: [material 2]: expected an object, got 42"
+    missing = write(tmp_path / "p.manifest.toml",
+                    '[[material]]\nname = "ok"\n\n[[material]]\npath = "sub/missing.toml"\n')
+    ok, lost = collect([missing])
+    assert (lost.file, lost.line) == (str(missing), 4) and "no such material file" in lost.error
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.lists(st.dictionaries(st.sampled_from(["name", "note", "x"]),
+                                st.text(alphabet='[]{},"\\#\' a\n', max_size=6)),
+                min_size=1, max_size=5), st.integers(0, 3))
+def test_json_entry_lines_survive_strings_that_look_like_structure(entries, indent):
+    """Brackets, braces, commas and escaped quotes inside strings do not move an entry's
+    line; one entry a line where the JSON is written so."""
+    text = json.dumps({"defaults": {"note": "[{"}, "material": entries}, indent=indent or None)
+    lines = entry_lines(text, is_json=True)
+    assert len(lines) == len(entries)
+    if indent:
+        rows = text.splitlines()
+        assert all(rows[line - 1].strip().startswith("{") for line in lines)
 
 
 def test_manifest_files_are_relative_to_who_wrote_them(tmp_path, monkeypatch):

@@ -111,12 +111,13 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any]
     """Entry ``index`` of a manifest, written from ``line`` (None: not known); its errors
     start ``FILE:LINE:`` as a material file's do, for editors and CI annotations."""
     def at_entry(label: str) -> str:
-        return f"{manifest}[{label}]" if line is None else f"{manifest}:{line}: [{label}]"
+        return f"{manifest}: [{label}]" if line is None else f"{manifest}:{line}: [{label}]"
 
     where = at_entry(f"material {index + 1}")
     if not isinstance(entry, dict):
-        return Item(f"{prefix}#{index + 1}", where, error=f"{where}: expected a table",
-                    file=str(manifest), line=line)
+        kind = "an object" if manifest.suffix.lower() == ".json" else "a table"
+        return Item(f"{prefix}#{index + 1}", where, error=f"{where}: expected {kind}, got "
+                    f"{entry!r:.40}", file=str(manifest), line=line)
     fields = {k: v for k, v in entry.items() if k not in ENTRY_KEYS}
     ref = entry.get("path")
     name = entry.get("name")
@@ -133,6 +134,9 @@ def _entry_item(manifest: Path, index: int, entry: Any, defaults: dict[str, Any]
         if ref is not None:
             if not isinstance(ref, str):
                 raise MaterialError(f"{where}: path={ref!r} must be a string")
+            if not (manifest.parent / ref).is_file():  # the entry's mistake, at its line
+                raise MaterialError(f"{where}: path={ref!r}: no such material file beside "
+                                    "the manifest")
             table = read_table(manifest.parent / ref)
             if not table:
                 raise MaterialError(f"{where}: {ref} is an empty material file",
