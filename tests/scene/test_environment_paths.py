@@ -59,6 +59,22 @@ def test_local_requests_take_a_path_and_key_its_content(tmp_path):
         prepare(request, served)
 
 
+def test_a_key_does_not_depend_on_where_the_command_ran(tmp_path, monkeypatch):
+    """A batch run from another folder (or given the manifest's absolute path) rendered its
+    environment-map items again: the key held the path as written. Meshes were keyed by
+    their content already."""
+    (tmp_path / "set" / "maps").mkdir(parents=True)
+    write_hdr(tmp_path / "set" / "maps" / "red.hdr", (1.0, 0.1, 0.1))
+    keys = set()
+    for cwd, written in ((tmp_path, "set/maps/red.hdr"), (tmp_path / "set", "maps/red.hdr"),
+                         (tmp_path / "set" / "maps", "red.hdr"),
+                         ("/", str(tmp_path / "set" / "maps" / "red.hdr"))):
+        monkeypatch.chdir(cwd)
+        request = RenderRequest(preset="sphere", environment=written)
+        keys.add(prepare(request, local_context(None)).key)
+    assert len(keys) == 1
+
+
 def test_a_material_file_names_its_environment_beside_itself(tmp_path, monkeypatch):
     (tmp_path / "maps").mkdir()
     write_hdr(tmp_path / "maps" / "room.hdr", (1.0, 1.0, 1.0))

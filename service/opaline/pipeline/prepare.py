@@ -73,12 +73,15 @@ class Prepared:
         return replace(self, job=job, key=job.cache_key(self.scene_key))
 
 
-def scene(request: RenderRequest, named: Preset, context: Context) -> tuple[Preset, str]:
+def scene(request: RenderRequest, named: Preset,
+          context: Context) -> tuple[Preset, str, RenderRequest]:
     """The preset a request draws (``named``, or its mesh's if it names one) and its scene
     key, after checking that its environment exists: names are the built-ins plus the
     files of a folder, which the schema cannot list, so an unknown one is refused like an
     unknown preset. A file's content is part of the key: replaced under its name, it
-    draws anew (and its canonical URL's rev changes) where the old image was answered."""
+    draws anew (and its canonical URL's rev changes) where the old image was answered.
+    Where a map may be named by its path, the request names it by its absolute one, so
+    that a key does not depend on where a command ran (a batch's up-to-date check did)."""
     preset = named
     if request.mesh is not None:
         preset = context.meshes(request, named)
@@ -91,12 +94,14 @@ def scene(request: RenderRequest, named: Preset, context: Context) -> tuple[Pres
             raise UnknownEnvironment(str(exc)) from None
         if path is not None:
             key = f"{key}+{known_file_digest(path)}"
-    return preset, key
+            if context.environment_paths:
+                request = request.model_copy(update={"environment": str(path.resolve())})
+    return preset, key, request
 
 
 def prepare(request: RenderRequest, context: Context) -> Prepared:
     named = get_preset(request.preset)
-    preset, scene_key = scene(request, named, context)
+    preset, scene_key, request = scene(request, named, context)
     job = resolve(request, preset)
     check_limits(job, context.limits)
     return Prepared(request, preset, job, job.cache_key(scene_key), named, scene_key)
