@@ -548,3 +548,19 @@ def test_bad_options_are_usage_errors(tmp_path, capsys, option, message):
     assert run_cli("batch", str(folder), "--out", str(tmp_path / "out"), *option) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.gl
+def test_a_second_batch_of_a_folder_passes_over_the_first_ones_outputs(tmp_path, backend):
+    """`batch . --out thumbs` then `batch . --out thumbs2`: the second read thumbs/'s
+    sidecars and summary as material files, failed them and exited 1. An earlier batch's
+    output folder, and its sidecars wherever a --summary elsewhere left them, are skipped."""
+    make_folder(tmp_path, {"a.toml": 'preset = "cd-rom"\n' + SMALL})
+    first = tmp_path / "thumbs"
+    assert run_cli("batch", str(tmp_path), "--out", str(first), "--backend", backend) == 0
+    apart = tmp_path / "apart"
+    assert run_cli("batch", str(tmp_path), "--out", str(apart), "--summary",
+                   str(tmp_path / "elsewhere.txt"), "--backend", backend) == 0
+    again = tmp_path / "thumbs2"
+    assert run_cli("batch", str(tmp_path), "--out", str(again), "--backend", backend) == 0
+    assert sorted(by_name(summary_of(again))) == ["a"]

@@ -138,6 +138,28 @@ def prune(out: Path, names: set[str]) -> list[Path]:
     return removed
 
 
+def earlier_outputs(inputs: list[str | Path]) -> list[Path]:
+    """What earlier batches wrote inside input folders: their output folders (those that
+    hold a batch summary) and any sidecar elsewhere, which are JSON but no material files
+    (a second batch of a folder over its first's read them and failed)."""
+    found = []
+    for folder in (Path(raw) for raw in inputs if Path(raw).is_dir()):
+        for summary in folder.rglob("summary.json"):
+            if _is_summary(summary):
+                found.append(summary.parent.resolve())
+        found += [path.resolve() for path in folder.rglob("*.json")
+                  if path.with_suffix("").suffix in EXTENSIONS.values() and _is_sidecar(path)]
+    return found
+
+
+def _is_summary(path: Path) -> bool:
+    try:
+        found = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(found, dict) and {"opaline", "items", "counts"} <= found.keys()
+
+
 def _is_sidecar(path: Path) -> bool:
     try:
         return "key" in json.loads(path.read_text())

@@ -24,7 +24,14 @@ from pathlib import Path
 from typing import Any
 
 from opaline import __version__
-from opaline.batch.plan import Task, plan, prune, remove_temporaries, write_result
+from opaline.batch.plan import (
+    Task,
+    earlier_outputs,
+    plan,
+    prune,
+    remove_temporaries,
+    write_result,
+)
 from opaline.batch.pool import Outcome, start_pool
 from opaline.batch.progress import PlainProgress, make_progress
 from opaline.batch.shard import select
@@ -65,7 +72,8 @@ def run_batch(inputs: list[str | Path], options: Options,
               progress: PlainProgress | None = None) -> dict[str, Any]:
     """Render every input; returns the summary (also written to ``options.summary_path``)."""
     started = time.monotonic()
-    items = collect(inputs, options.overrides, exclude=[options.out, options.summary_path])
+    items = collect(inputs, options.overrides,
+                    exclude=[options.out, options.summary_path, *earlier_outputs(inputs)])
     if not items:
         shown = ", ".join(map(str, inputs))
         raise NothingToRender(f"no material files (.toml/.json) found in {shown}")
