@@ -243,3 +243,21 @@ def test_another_context_on_the_thread_does_not_corrupt_renders(on_thread, backe
 
     before, after = on_thread(with_intruder)
     assert before == after
+
+
+def test_exports_and_turntables_read_requests_as_render_does():
+    """export_material took any kind but "glsl" for a .glb ("GLSL", "fbx") and, with
+    render_turntable, took {"mu_f": "6"} and {"mu_f": True}, which render() refuses; an
+    out-of-range value raised pydantic's own error, not RequestError."""
+    from opaline import export_material, render_turntable
+
+    for kind in ("GLSL", "fbx"):
+        with pytest.raises(ValueError, match="expected one of glsl, glb"):
+            export_material({"preset": "sphere"}, kind)
+    for loose in ({"mu_f": "6"}, {"mu_f": True}, {"mu_f": 5000}):
+        with pytest.raises(api_python.RequestError, match="mu_f"):
+            export_material({"preset": "cd-rom", **loose}, "glsl")
+        with pytest.raises(api_python.RequestError, match="mu_f"):
+            render_turntable({"preset": "cd-rom", "frames": 2, "width": 16, "height": 16,
+                              **loose})
+    assert export_material({"preset": "cd-rom", "mu_f": 6}, "glsl").startswith(b"//")

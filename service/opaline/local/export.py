@@ -8,24 +8,24 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 from opaline.gl.export_glsl import export_glsl
+from opaline.local.api import RequestLike, as_request
 from opaline.local.context import local_context
-from opaline.model.params import RenderRequest
 from opaline.output.gltf import export_preset_glb, import_glb
 from opaline.pipeline.prepare import prepare
 
 ExportKind = Literal["glsl", "glb"]
 
 
-def export_material(request: RenderRequest | Mapping[str, Any], kind: ExportKind) -> bytes:
-    """GLSL source (UTF-8) or .glb bytes of the request's material (and, for .glb, mesh)."""
-    if not isinstance(request, RenderRequest):
-        request = RenderRequest.model_validate(dict(request))
-    prepared = prepare(request, local_context(cost_budget=None))
+def export_material(request: RequestLike, kind: ExportKind) -> bytes:
+    """GLSL source (UTF-8) or .glb bytes of the request's material (and, for .glb, mesh);
+    the request is read as ``render``'s (a RequestError names a bad field)."""
+    if kind not in get_args(ExportKind):  # "GLSL" or "fbx" silently gave a .glb
+        raise ValueError(f"kind={kind!r}: expected one of {', '.join(get_args(ExportKind))}")
+    prepared = prepare(as_request(request), local_context(cost_budget=None))
     preset, job = prepared.preset, prepared.job
     if kind == "glsl":
         return export_glsl(job.material, job.wavelengths).encode()

@@ -19,6 +19,7 @@ from pydantic import ValidationError
 from opaline.local.api import RequestError, renderer
 from opaline.local.pipeline import LocalRenderer, budget_of, prepare_locally
 from opaline.model.params import describe_errors
+from opaline.model.strict_json import validate_strictly
 from opaline.model.turntable import TurntableRequest, check_turntable_cost, frame_jobs
 from opaline.output.animation import encode
 from opaline.output.encode import quantise
@@ -32,7 +33,8 @@ def as_turntable(request: TurntableRequest | Mapping[str, Any]) -> TurntableRequ
     if isinstance(request, TurntableRequest):
         return request
     try:
-        return TurntableRequest.model_validate(dict(request))
+        # As render() and a JSON body read it: {"mu_f": "6"} and {"mu_f": True} refused.
+        return validate_strictly(dict(request), TurntableRequest)
     except ValidationError as exc:
         raise RequestError(describe_errors(exc, TurntableRequest)) from None
 
