@@ -98,3 +98,12 @@ def test_a_header_longer_than_the_bound_is_refused_unread(tmp_path):
                                         + PIXELS)
     with pytest.raises(EnvironmentMapError, match="64 KiB"):
         environment_files.read_file(tmp_path / "long.hdr")
+
+
+def test_a_file_cut_short_is_said_once_and_opencv_stays_quiet(tmp_path, capfd):
+    """OpenCV logged its own "[ERROR:0@0.007] ... RGBE read error" to stderr, past the CLI's
+    -q, before Opaline's one line; and the line said "not a Radiance .hdr image"."""
+    (tmp_path / "cut.hdr").write_bytes(b"#?RADIANCE\n" + FORMAT + b"\n" + SIZE + PIXELS[:40])
+    with pytest.raises(EnvironmentMapError, match="8 × 4.*cut short"):
+        environment_files.read_file(tmp_path / "cut.hdr")
+    assert capfd.readouterr().err == ""

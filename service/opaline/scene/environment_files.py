@@ -107,12 +107,20 @@ def _read_radiance(path: Path) -> np.ndarray:
     _check_size(width, height)
     import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
 
+    # OpenCV logs a file it cannot read to stderr itself, past the CLI's -q: the error
+    # raised here says it once, so its log is silenced for the read (and restored).
+    logging_ = cv2.utils.logging
+    level = logging_.getLogLevel()
+    logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)
     try:
         decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
     except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
         raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
+    finally:
+        logging_.setLogLevel(level)
     if decoded is None or decoded.shape[:2] != (height, width):
-        raise ValueError("not a Radiance .hdr image")
+        raise ValueError(f"its header reads ({width} × {height}) but its pixels do not: "
+                         "the file is cut short or damaged")
     image: np.ndarray = np.asarray(decoded, dtype=np.float32)[..., 2::-1]
     return image
 
