@@ -222,6 +222,11 @@ def test_presets_dir_option_and_environment(capsys, tmp_path, monkeypatch, own_p
     assert run(capsys, "presets")[1].split()[0] == "my-disc"
     line = one_line_error(*run(capsys, "--presets-dir", str(tmp_path / "nope"), "presets")[::2])
     assert "no such folder" in line
+    # The variable naming no folder is said too: it listed no presets and exited 0.
+    monkeypatch.setenv(PRESETS_ENV, str(tmp_path / "nope"))
+    for argv in (["presets"], ["render", "sphere", *TINY, "-o", str(tmp_path / "x.png")]):
+        line = one_line_error(*run(capsys, *argv)[::2])
+        assert f"{PRESETS_ENV}=" in line and "no such folder" in line
 
 
 def test_presets_dir_is_offered_by_the_commands_that_read_presets(capsys):

@@ -115,8 +115,13 @@ def make_parser() -> argparse.ArgumentParser:
 
 
 def use_presets_dir(folder: str | None) -> None:
-    """--presets-dir: the same as $OPALINE_PRESETS_DIR, set before any preset is loaded."""
+    """--presets-dir: the same as $OPALINE_PRESETS_DIR, set before any preset is loaded.
+    Either naming no folder is an error (the variable's was taken as a folder of no
+    presets: `presets` listed none and `render` offered "choose one of " nothing)."""
     if folder is None:
+        chosen = os.environ.get(PRESETS_ENV)
+        if chosen and not Path(chosen).expanduser().is_dir():
+            raise CliError(f"{PRESETS_ENV}={chosen}: no such folder")
         return
     if not Path(folder).expanduser().is_dir():
         raise CliError(f"--presets-dir {folder}: no such folder")
