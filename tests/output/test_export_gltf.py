@@ -66,6 +66,14 @@ def test_cli_export_import_render(tmp_path, capsys):
     glsl = tmp_path / "cd.glsl"
     assert cli.main(["export", "cd-rom", "-o", str(glsl)]) == 0
     assert "vec3 opaline_radiance(vec3 n, vec3 t, vec3 l, vec3 v)" in glsl.read_text()
+    capsys.readouterr()
+    # What no render could read is not written: an unknown preset, JSON in a .toml.
+    for argv, said in ((["--preset", "nope", "-o", str(tmp_path / "n.json")], "nope"),
+                       (["-o", str(tmp_path / "b.toml")], "name it .json")):
+        assert cli.main(["import", str(glb), *argv]) == 2
+        assert said in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cd.glb", "cd.glsl", "cd.json",
+                                                         "cd.png"]
 
 
 def test_import_material_names_the_glb_as_mesh(tmp_path):

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from opaline.cli.args import (
+    STDOUT,
     CliError,
     add_common,
     add_source,
@@ -38,9 +39,16 @@ def cmd_export(args: argparse.Namespace) -> None:
 
 def cmd_import(args: argparse.Namespace) -> None:
     from opaline.local.export import import_material, material_file_text
+    from opaline.model.presets import UnknownPreset, get_preset
 
-    fields = import_material(args.source, args.preset)
     out = Path(args.output)
+    if args.output != STDOUT and out.suffix.lower() != ".json":  # a .toml failed to render
+        raise CliError(f"-o {args.output}: import writes a JSON material file: name it .json")
+    try:  # a preset that is not one wrote a file that no render could read
+        get_preset(args.preset)
+    except UnknownPreset as exc:
+        raise CliError(f"--preset {args.preset}: {exc}") from None
+    fields = import_material(args.source, args.preset)
     # The mesh path is written relative to the material file, as load_material reads it.
     try:
         fields["mesh"] = str(Path(fields["mesh"]).resolve().relative_to(out.resolve().parent))
