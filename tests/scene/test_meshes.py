@@ -145,7 +145,8 @@ def test_cli_and_material_file_render_a_mesh(capsys, tmp_path):
     broken = tmp_path / "broken.stl"
     broken.write_bytes(broken_files()["nan-vertex-stl"])
     assert cli.main(["render", "sphere", "--mesh", str(broken), "-o", str(tmp_path / "x.png")]) == 2
-    assert "NaN" in capsys.readouterr().err
+    said = capsys.readouterr().err
+    assert "NaN" in said and "mesh broken.stl: " in said  # the file named, as a review asked
 
 
 def test_a_zero_tangent_axis_is_named_in_plain_numbers():

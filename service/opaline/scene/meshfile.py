@@ -222,6 +222,8 @@ def load_mesh_file(path: str | Path, field: str = "auto",
         headroom = (parse_headroom() or 0) >> 20
         raise MeshError(f"mesh {path.name} needs more than {headroom} MB to read, over this "
                         "service's limit; send fewer triangles, or as GLB or binary PLY") from None
+    except MeshError as exc:  # the file's own fault, said with its name (a CLI user's --mesh)
+        raise MeshError(f"mesh {path.name}: {exc}") from None
     _loaded[key] = found
     while len(_loaded) > CACHED_MESHES:
         _loaded.popitem(last=False)
