@@ -111,6 +111,16 @@ def test_a_second_preset_is_one_line_not_a_traceback(capsys, tmp_path):
     assert "--set preset=nacre" in err and "'cd-rom'" in err and len(err.splitlines()) == 1
 
 
+def test_an_option_and_a_set_that_disagree_are_refused(capsys, tmp_path):
+    """--mesh A beside --set mesh=B drew A without a word (--size and --quality likewise)."""
+    out = str(tmp_path / "x.png")
+    for argv, said in ((["--mesh", "a.obj", "--set", "mesh=b.obj"], "--mesh and --set mesh=b"),
+                       (["--size", "32", "--set", "width=64"], "--size and --set width=64"),
+                       (["--quality", "draft", "--set", "quality=high"], "--quality and")):
+        code, _, err = run(capsys, "render", "sphere", *argv, "-o", out)
+        assert code == 2 and said in err and "give one" in err, err
+
+
 def test_bad_size_is_explained(capsys, tmp_path):
     """`--size big` exits 2 with the expected form."""
     code, _, err = run(capsys, "render", "cd-rom", "--size", "big", "-o", str(tmp_path / "x.png"))

@@ -199,13 +199,18 @@ def source_fields(args: argparse.Namespace) -> dict[str, Any]:
     """``--set``, ``--mesh`` and, where the command has them, ``--size`` and ``--quality``
     as request fields (the request model validates them)."""
     fields = parse_sets(args.set)
+    options: dict[str, Any] = {}
     if getattr(args, "size", None):
-        fields["width"], fields["height"] = parse_size(args.size)
+        options["width"], options["height"] = parse_size(args.size)
     if getattr(args, "quality", None):
-        fields["quality"] = args.quality
+        options["quality"] = args.quality
     if args.mesh:
-        fields["mesh"] = args.mesh
-    return fields
+        options["mesh"] = args.mesh
+    for name, value in options.items():  # one of the two silently won
+        if name in fields and fields[name] != value:
+            option = {"width": "--size", "height": "--size"}.get(name, f"--{name}")
+            raise CliError(f"{option} and --set {name}={fields[name]} disagree: give one")
+    return {**fields, **options}
 
 
 def add_common(parser: argparse.ArgumentParser) -> None:
