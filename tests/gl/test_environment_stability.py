@@ -47,7 +47,6 @@ def environments(renderer, tmp_path_factory):
     names = {name: write_environment(folder, name) for name in ENVIRONMENT_MAPS}
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(renderer.environments, "environments_dir", folder)
-        patch.setattr(renderer.surface, "environments_dir", folder)
         yield names
 
 
