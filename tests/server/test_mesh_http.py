@@ -90,6 +90,16 @@ def test_folder_meshes_by_name(client):
 
 
 @pytest.mark.gl
+def test_a_mesh_refused_at_render_names_the_field(client):
+    """tangent_field='uv' on an STL (no UVs) was a 422 whose `fields` was empty."""
+    mesh_id = client.post("/v1/meshes", content=mesh_bytes("stl")).json()["id"]
+    answer = client.get(f"/v1/render?mesh={mesh_id}&tangent_field=uv&{SMALL}")
+    assert answer.status_code == 422, answer.text
+    assert [p["field"] for p in answer.json()["fields"]] == ["tangent_field"]
+    assert "no UV coordinates" in answer.json()["fields"][0]["message"]
+
+
+@pytest.mark.gl
 @pytest.mark.parametrize("name", sorted(broken_files()))
 def test_broken_uploads_get_422_and_the_service_stays_ready(client, name):
     answer = client.post("/v1/meshes", content=broken_files()[name])

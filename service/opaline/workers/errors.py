@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 from opaline.errors import PublicError
+
+# "mesh NAME: tangent_field='uv' but ...", "environment NAME: cannot read: ...": the file's
+# field, and a field the message names first.
+FILE_FIELD = re.compile(r"^(?:(mesh|environment) [^:]+: )?(?:(\w+)=)?")
 
 
 class Overloaded(PublicError):
@@ -63,9 +69,21 @@ class RenderFailed(PublicError):
 
 
 class InvalidInput(PublicError, ValueError):
-    """The worker refused the job's input (a malformed or over-limit mesh file) (422)."""
+    """The worker refused the job's input (a malformed or over-limit mesh file, an
+    environment map it cannot read) (422); its ``fields`` name the request field at fault
+    (they were empty: a tangent_field='uv' on a mesh without UVs named none)."""
 
     status, reason = 422, "invalid"
+
+    def field_problems(self) -> list[dict[str, str]]:
+        from opaline.model.params import RenderRequest
+
+        text = str(self)
+        found = FILE_FIELD.match(text)
+        if found is None:
+            return []
+        name = found.group(2) if found.group(2) in RenderRequest.model_fields else found.group(1)
+        return [{"field": name, "message": text}] if name else []
 
 
 # The exception each non-failure reply kind of a worker becomes.
