@@ -30,7 +30,7 @@ from opaline.workers.errors import (
     TooSlow,
     Unavailable,
 )
-from opaline.workers.job import Job, Store
+from opaline.workers.job import Job, Store, awaited
 from opaline.workers.slot import Slot
 from opaline.workers.tasks import Task
 
@@ -146,7 +146,7 @@ class WorkerPool:
         """Submit and await; ``gone`` resolves when the client has left, which withdraws
         this waiter (and drops the job if it was the last)."""
         job = self.submit(key, task, label)
-        result = asyncio.ensure_future(asyncio.wrap_future(job.future))
+        result = awaited(job.future)
         watch = asyncio.ensure_future(gone()) if gone is not None else None
         try:
             waits = {result} | ({watch} if watch is not None else set())
