@@ -76,6 +76,14 @@ def test_cli_export_import_render(tmp_path, capsys):
                                                          "cd.png"]
 
 
+def test_a_glb_cut_short_is_said_so():
+    """A truncated .glb was read by pygltflib as a document without materials: "the glTF
+    file has no material"."""
+    data = export_material({"preset": "sphere"}, "glb")
+    with pytest.raises(GltfImportError, match=f"cut short: {len(data) // 2} of its {len(data)}"):
+        import_glb(data[:len(data) // 2])
+
+
 def test_import_material_names_the_glb_as_mesh(tmp_path):
     path = tmp_path / "s.glb"
     path.write_bytes(export_material({"preset": "sphere", "alpha": 3.0}, "glb"))

@@ -54,6 +54,10 @@ def load_document(data: bytes) -> gl.GLTF2:
     # cold `opaline render` that reads no .glb (tests/test_cold_start.py).
     import pygltflib as gl
 
+    if data[:4] == b"glTF" and len(data) >= 12:  # the header's length: pygltflib reads
+        declared = int.from_bytes(data[8:12], "little")  # a cut file as an empty document
+        if len(data) < declared:
+            raise ValueError(f"the .glb is cut short: {len(data)} of its {declared} bytes")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # pygltflib warns, then may answer None
