@@ -564,3 +564,10 @@ def test_a_second_batch_of_a_folder_passes_over_the_first_ones_outputs(tmp_path,
     again = tmp_path / "thumbs2"
     assert run_cli("batch", str(tmp_path), "--out", str(again), "--backend", backend) == 0
     assert sorted(by_name(summary_of(again))) == ["a"]
+    # A summary written among the inputs excludes itself, not the folder it is in: the
+    # second run found "no material files" in the input itself.
+    beside = tmp_path / "summary.json"
+    for _ in range(2):
+        assert run_cli("batch", str(tmp_path), "--out", str(tmp_path / "renders"),
+                       "--summary", str(beside), "--backend", backend) == 0
+    assert sorted(item["name"] for item in json.loads(beside.read_text())["items"]) == ["a"]

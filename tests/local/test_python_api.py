@@ -78,6 +78,42 @@ assert api.render(SMALL, backend={backend!r}).startswith(b"\\x89PNG")
     assert result.returncode == 0, result.stderr
 
 
+def test_a_fork_does_not_release_the_parents_contexts(backend, tmp_path):
+    """A fork drops the other threads' locals in the child, on its main thread: the release
+    at a thread's end ran there, on a copy of the parent's GL state, from a thread that did
+    not own the context (a review found it). In the child it is skipped."""
+    marker = tmp_path / "released"
+    code = f"""
+import os, threading
+from opaline.local import api, pipeline
+closing = pipeline.LocalRenderer.close
+def close(self):
+    with open({str(marker)!r}, "a") as out:
+        out.write(f"{{os.getpid()}}\\n")
+    closing(self)
+pipeline.LocalRenderer.close = close
+rendered, done = threading.Event(), threading.Event()
+def work():
+    api.render({{"preset": "sphere", "width": 16, "height": 16}}, backend={backend!r})
+    rendered.set()
+    done.wait()
+thread = threading.Thread(target=work)
+thread.start()
+rendered.wait()
+child = os.fork()
+if child == 0:
+    os._exit(0)
+os.waitpid(child, 0)
+done.set()
+thread.join()
+print(os.getpid())
+"""
+    result = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert marker.read_text().split() == [result.stdout.strip()]  # the parent's own, once
+
+
 def test_unknown_attribute_of_opaline_is_an_attribute_error():
     """The lazy `opaline.__getattr__` still raises AttributeError for names it does not know."""
     import opaline

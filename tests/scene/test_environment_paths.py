@@ -101,3 +101,29 @@ def test_the_python_api_lights_by_the_file_at_a_path(local, tmp_path):
         image = local.render_array(request)
         means[name] = image[..., :3][image[..., 3] > 0.5].mean(0)
     assert means["red"][0] > 3 * means["red"][2] and means["blue"][2] > 3 * means["blue"][0]
+
+
+def test_a_link_keeps_its_own_name_and_a_users_home_that_is_none_is_a_plain_error(tmp_path):
+    """A map that is a link to a content store's suffix-less blob was renamed to the blob's
+    path by the key's absolute path, which then was no map ("not known"); and `~nobody/`
+    raised RuntimeError past every caller (a batch's collect aborted)."""
+    (tmp_path / "store").mkdir(), (tmp_path / "maps").mkdir()
+    write_hdr(tmp_path / "store" / "blob.hdr", (1.0, 1.0, 1.0))
+    (tmp_path / "store" / "blob.hdr").rename(tmp_path / "store" / "blob")
+    (tmp_path / "maps" / "loft.hdr").symlink_to(tmp_path / "store" / "blob")
+    from opaline.local.context import file_meshes
+
+    context = Context(Limits(None), file_meshes, tmp_path / "maps", environment_paths=True)
+    for written in ("loft.hdr", str(tmp_path / "maps" / "loft.hdr")):
+        job = prepare(RenderRequest(preset="sphere", environment=written), context).job
+        assert job.environment is not None and job.environment.endswith("loft.hdr")
+        assert environments.check_name(job.environment, tmp_path / "maps", paths=True)
+    with pytest.raises(EnvironmentMapError, match="no such file"):
+        environments.check_name("~nosuchuser4711/x.hdr", None, paths=True)
+    manifest = tmp_path / "m.manifest.toml"
+    manifest.write_text('[[material]]\nname = "a"\nenvironment = "~nosuchuser4711/x.hdr"\n'
+                        'mesh = "~nosuchuser4711/m.obj"\n')
+    from opaline.model.materials import collect
+
+    (item,) = collect([manifest])
+    assert item.request is not None and "nosuchuser4711" in str(item.request.environment)

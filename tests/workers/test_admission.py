@@ -203,6 +203,26 @@ def test_a_scan_at_the_triangle_limit_is_admitted(tmp_path, fields):
     assert 5.4 <= found <= 0.75 * DEADLINE_S, found
 
 
+def test_a_mesh_read_taking_what_was_predicted_leaves_the_pace_alone(tmp_path):
+    """The read is predicted without the safety factor; the pace took a render's model time
+    as prediction / safety, so a scan read in exactly its predicted seconds counted as
+    slower than predicted and raised every prediction after it."""
+    path = tmp_path / "scan.ply"
+    with open(path, "wb") as stream:
+        stream.write(b"ply\n")
+        os.truncate(stream.fileno(), 38 << 20)
+    task = ImageTask(prepare(RenderRequest(preset="sphere", mesh=str(path), width=64,
+                                           height=64), local_context(None)))
+    found = model()
+    predicted = found.predict(*task.units())
+    label, units, wavelengths, draw_s, load, read_s = task.units()
+    assert read_s > 5.0
+    as_modelled = (predicted - read_s) / SAFETY + read_s  # the read and the shading's fit
+    for _ in range(12):
+        found.observe(task, predicted, as_modelled)
+    assert found.pace.factor() == 1.0
+
+
 def test_a_refusal_names_the_fields_that_made_it_slow(tmp_path):
     """The too_slow 422 said to lower width, height, samples or wavelengths, with no field,
     where the request had set environment_samples=4096 (the tier's own is 4); and a mesh

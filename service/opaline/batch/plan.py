@@ -139,25 +139,37 @@ def prune(out: Path, names: set[str]) -> list[Path]:
 
 
 def earlier_outputs(inputs: list[str | Path]) -> list[Path]:
-    """What earlier batches wrote inside input folders: their output folders (those that
-    hold a batch summary) and any sidecar elsewhere, which are JSON but no material files
-    (a second batch of a folder over its first's read them and failed)."""
+    """What earlier batches wrote inside input folders: their summaries, the output folders
+    those name, and sidecars wherever they are: JSON, but no material files (a second
+    batch of a folder over its first's read them and failed). A summary written among the
+    inputs (``--summary``) excludes itself, not its folder."""
     found = []
     for folder in (Path(raw) for raw in inputs if Path(raw).is_dir()):
-        for summary in folder.rglob("summary.json"):
-            if _is_summary(summary):
-                found.append(summary.parent.resolve())
+        for summary in folder.rglob("*.json"):
+            out = _summary_out(summary)
+            if out is not None:
+                found += [summary.resolve(), out.resolve()]
         found += [path.resolve() for path in folder.rglob("*.json")
                   if path.with_suffix("").suffix in EXTENSIONS.values() and _is_sidecar(path)]
     return found
 
 
-def _is_summary(path: Path) -> bool:
+def _summary_out(path: Path) -> Path | None:
+    """The output folder a batch summary names, or None where ``path`` is none."""
     try:
         found = json.loads(path.read_text())
     except (OSError, ValueError):
-        return False
-    return isinstance(found, dict) and {"opaline", "items", "counts"} <= found.keys()
+        return None
+    if not isinstance(found, dict) or not {"opaline", "items", "counts", "out"} <= found.keys():
+        return None
+    if not isinstance(found["out"], str):
+        return None
+    out = Path(found["out"])
+    # Written as given to --out: relative to where that batch ran, unknown here, except
+    # where the summary sits in it, as it does by default.
+    if not out.is_absolute() and path.name == "summary.json" and path.parent.name == out.name:
+        return path.parent
+    return out
 
 
 def _is_sidecar(path: Path) -> bool:

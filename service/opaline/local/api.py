@@ -85,7 +85,9 @@ def renderer(backend: BackendName | None = None) -> LocalRenderer:
         # Released when the thread ends, should it never call close(): the thread's locals
         # are dropped on that thread as it exits, where the context is current. Not at the
         # interpreter's exit, which runs on the main thread, not the context's.
-        _local.ends, _local.release = (end := _ThreadEnd()), weakref.finalize(end, found.close)
+        _local.ends = end = _ThreadEnd()
+        _local.release = weakref.finalize(end, _release, found, os.getpid(),
+                                          threading.get_ident())
         _local.release.atexit = False
     return found
 
@@ -109,6 +111,13 @@ def close() -> None:
     _local.renderer = _local.backend = _local.ends = _local.release = None
     if release is not None:
         release()  # at most once: a finalizer called is dead
+
+
+def _release(found: LocalRenderer, pid: int, thread: int) -> None:
+    """``found.close()`` on the thread and in the process that made it: a fork drops the
+    other threads' locals in the child, on its main thread, whose GL state is a copy."""
+    if os.getpid() == pid and threading.get_ident() == thread:
+        found.close()
 
 
 class _ThreadEnd:

@@ -20,6 +20,7 @@ from pydantic import ValidationError
 from opaline.model.params import RenderRequest, describe_errors
 from opaline.model.strict_json import DuplicateKey, refuse_duplicate_keys, validate_strictly
 from opaline.scene.environments import SUFFIXES as ENVIRONMENT_SUFFIXES
+from opaline.scene.environments import expand_user
 
 SUFFIXES = (".toml", ".json")
 SCHEMA_KEY = "$schema"  # allowed in files so editors can find the schema; ignored
@@ -134,7 +135,7 @@ def files_beside(path: Path, fields: dict[str, Any]) -> dict[str, Any]:
     as an editor sees them: relative to that file, not to where the command runs."""
     found = dict(fields)
     if isinstance(found.get("mesh"), str):
-        found["mesh"] = str(path.parent / Path(found["mesh"]).expanduser())
+        found["mesh"] = str(path.parent / expand_user(Path(found["mesh"])))
     if isinstance(found.get("environment"), str):
         found["environment"] = environment_beside(path, found["environment"])
     return found
@@ -146,7 +147,7 @@ def environment_beside(path: Path, environment: str) -> str:
     one of the environments folder's (scene.environments.check_name)."""
     if not environment.lower().endswith(ENVIRONMENT_SUFFIXES):
         return environment
-    written = Path(environment).expanduser()
+    written = expand_user(Path(environment))
     beside = path.parent / written
     if written.name != environment or beside.is_file():
         return str(beside)

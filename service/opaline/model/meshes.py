@@ -10,7 +10,7 @@ from typing import Any
 from opaline.digests import file_digest
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
-from opaline.scene.environments import MESH_ENVIRONMENT
+from opaline.scene.environments import MESH_ENVIRONMENT, expand_user
 from opaline.scene.gltf_film import film_texture_names
 
 MESH_KIND = "file"
@@ -63,7 +63,7 @@ class MeshFileMissing(ValueError):
 def file_mesh_preset(base: Preset, request: SceneFields, max_triangles: int) -> Preset:
     """``base`` drawing the mesh file ``request.mesh`` (a path on this machine)."""
     assert request.mesh is not None
-    path = Path(request.mesh).expanduser()
+    path = expand_user(Path(request.mesh))
     if not path.is_file():
         raise MeshFileMissing(f"mesh={request.mesh!r}: no such file")
     return mesh_preset(base, path.resolve(), file_digest(path), request, max_triangles)

@@ -95,7 +95,9 @@ def scene(request: RenderRequest, named: Preset,
         if path is not None:
             key = f"{key}+{known_file_digest(path)}"
             if context.environment_paths:
-                request = request.model_copy(update={"environment": str(path.resolve())})
+                # absolute(), not resolve(): a link to a content store's suffix-less blob
+                # must keep its own name, which says it is a map
+                request = request.model_copy(update={"environment": str(path.absolute())})
     return preset, key, request
 
 

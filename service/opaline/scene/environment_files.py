@@ -26,6 +26,7 @@ from __future__ import annotations
 import logging
 import math
 import re
+import threading
 from pathlib import Path
 from typing import BinaryIO
 
@@ -46,6 +47,7 @@ RADIANCE_FORMAT = b"FORMAT=32-bit_rle_rgbe\n"
 MAX_RADIANCE_HEADER = 1 << 16
 
 log = logging.getLogger(__name__)
+_QUIET_OPENCV = threading.Lock()
 
 
 class EnvironmentMapError(ValueError):
@@ -108,16 +110,18 @@ def _read_radiance(path: Path) -> np.ndarray:
     import cv2  # opencv-python-headless: reads Radiance RGBE as float32 BGR
 
     # OpenCV logs a file it cannot read to stderr itself, past the CLI's -q: the error
-    # raised here says it once, so its log is silenced for the read (and restored).
+    # raised here says it once, so its log is silenced for the read (and restored; the
+    # level is the process's, so one read at a time: the Python API's threads).
     logging_ = cv2.utils.logging
-    level = logging_.getLogLevel()
-    logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)
-    try:
-        decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
-    except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
-        raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
-    finally:
-        logging_.setLogLevel(level)
+    with _QUIET_OPENCV:
+        level = logging_.getLogLevel()
+        logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)
+        try:
+            decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+        except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV allows
+            raise ValueError(f"OpenCV refused it: {exc.err} ({exc.func})") from None
+        finally:
+            logging_.setLogLevel(level)
     if decoded is None or decoded.shape[:2] != (height, width):
         raise ValueError(f"its header reads ({width} × {height}) but its pixels do not: "
                          "the file is cut short or damaged")

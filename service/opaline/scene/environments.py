@@ -71,9 +71,9 @@ def check_name(name: str, folder: Path | None, paths: bool = False) -> Path | No
         if path.is_file():
             return path
     if paths and name.lower().endswith(SUFFIXES):
-        path = Path(name).expanduser()
+        path = expand_user(Path(name))
         if path.is_file():
-            return path.resolve()
+            return path.absolute()
         if Path(name).name != name:  # meant as a path: say so, as a missing mesh does
             raise EnvironmentMapError(f"environment={name!r}: no such file")
     # A path is not a name: a file is named as it is in the folder (which the message
@@ -84,6 +84,15 @@ def check_name(name: str, folder: Path | None, paths: bool = False) -> Path | No
         f"the name of an .hdr/.exr file of {where}"
     raise EnvironmentMapError(f"environment={name!r} is not known: choose studio, neutral, "
                               f"sky, none, or {files}")
+
+
+def expand_user(path: Path) -> Path:
+    """``~`` and ``~user`` expanded where they name a home; as written where not (an
+    unknown user raised RuntimeError, past every caller's handling of a bad name)."""
+    try:
+        return path.expanduser()
+    except RuntimeError:
+        return path
 
 
 def map_identity(name: str, folder: Path | None, paths: bool = False) -> tuple[object, ...]:

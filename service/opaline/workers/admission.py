@@ -134,11 +134,12 @@ class CostModel:
         return (SAFETY * estimate + read_s) * self.pace.factor()
 
     def observe(self, task: Any, predicted: float, seconds: float) -> None:
-        """A render predicted at ``predicted`` (``predict_task``) took ``seconds``."""
-        # Renders, not checks or encodes; and against the calibration, not the built-in
-        # guess before it (several times too long: it would hold the average low).
+        """A render predicted at ``predicted`` took ``seconds``; renders only, once calibrated
+        (the built-in guess is several times too long: it would hold the average low)."""
         if self.calibrated and getattr(task, "variant", None) is not None:
-            self.pace.observe(predicted / (SAFETY * self.pace.factor()), seconds)
+            read_s = getattr(task, "read_s", 0.0)  # predicted without the safety factor
+            self.pace.observe((predicted / self.pace.factor() - read_s) / SAFETY + read_s,
+                              seconds)
 
     def _slowest(self) -> Coefficients:
         """What a label with no timing of its own is priced by: the slowest calibrated

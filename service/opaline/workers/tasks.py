@@ -137,6 +137,11 @@ class ImageTask:
             named.append("mesh")
         return advice, named
 
+    @property
+    def read_s(self) -> float:
+        """Seconds of the mesh file's read that ``units`` counts (admission's pace)."""
+        return self._mesh_s()[0]
+
     def _mesh_s(self) -> tuple[float, float]:
         """Seconds the request's mesh file costs a render: its read, and its drawing."""
         args = self.prepared.preset.geometry.args
