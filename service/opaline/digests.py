@@ -1,6 +1,7 @@
 """Content hashes of files: what names an uploaded mesh, a mesh of the meshes folder and an
 environment file in keys, so that an edited file draws anew. A file named again and again
-(a folder's mesh, an environment) is hashed again only when its size or time changes."""
+(a folder's mesh, a local mesh file, an environment) is hashed again only when its size
+or time changes."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from opaline.digests import file_digest
+from opaline.digests import known_file_digest
 from opaline.model.presets import Generator, Preset
 from opaline.model.scene_fields import SceneFields
 from opaline.scene.environments import MESH_ENVIRONMENT, expand_user
@@ -66,4 +66,7 @@ def file_mesh_preset(base: Preset, request: SceneFields, max_triangles: int) -> 
     path = expand_user(Path(request.mesh))
     if not path.is_file():
         raise MeshFileMissing(f"mesh={request.mesh!r}: no such file")
-    return mesh_preset(base, path.resolve(), file_digest(path), request, max_triangles)
+    # Hashed again only when the file changes, as the meshes folder's and environment
+    # files are: each render of the Python API's or a batch's mesh read it whole.
+    path = path.resolve()
+    return mesh_preset(base, path, known_file_digest(path), request, max_triangles)
