@@ -145,12 +145,11 @@ def earlier_outputs(inputs: list[str | Path]) -> list[Path]:
     inputs (``--summary``) excludes itself, not its folder."""
     found = []
     for folder in (Path(raw) for raw in inputs if Path(raw).is_dir()):
-        for summary in folder.rglob("*.json"):
-            out = _summary_out(summary)
-            if out is not None:
-                found += [summary.resolve(), out.resolve()]
-        found += [path.resolve() for path in folder.rglob("*.json")
-                  if path.with_suffix("").suffix in EXTENSIONS.values() and _is_sidecar(path)]
+        for path in folder.rglob("*.json"):  # one walk; a sidecar is read once
+            if path.with_suffix("").suffix in EXTENSIONS.values() and _is_sidecar(path):
+                found.append(path.resolve())
+            elif (out := _summary_out(path)) is not None:
+                found += [path.resolve(), out.resolve()]
     return found
 
 
