@@ -79,9 +79,8 @@ class InvalidInput(PublicError, ValueError):
         from opaline.model.params import RenderRequest
 
         text = str(self)
-        found = FILE_FIELD.match(text)
-        if found is None:
-            return []
+        found = FILE_FIELD.match(text)  # every part optional: it always matches
+        assert found is not None
         name = found.group(2) if found.group(2) in RenderRequest.model_fields else found.group(1)
         return [{"field": name, "message": text}] if name else []
 

@@ -20,7 +20,13 @@ from opaline.pipeline.limits import Limits
 from opaline.pipeline.prepare import Context, Prepared
 from opaline.pipeline.produce import produce
 from opaline.scene.environments import BUILTIN
-from opaline.workers.admission import MDF_LABEL, RENDER_ADVICE, mesh_cost_s, shading_index
+from opaline.workers.admission import (
+    CHECK_ADVICE,
+    MDF_LABEL,
+    RENDER_ADVICE,
+    mesh_cost_s,
+    shading_index,
+)
 
 StopCheck = Callable[[], bool]
 # The fields a request sets that drive a render's time, as a refusal names them.
@@ -132,8 +138,8 @@ class ImageTask:
                   if named else RENDER_ADVICE)
         read_s, draw_s = self._mesh_s()
         if read_s + draw_s >= 0.5 * predicted:
-            advice = (f"its mesh file alone takes about {read_s + draw_s:.1f} s (send one with "
-                      f"fewer triangles; GLB or binary PLY read fastest); or {advice}")
+            advice = (f"its mesh file alone takes about {read_s + draw_s:.1f} s: {CHECK_ADVICE};"
+                      f" or {advice}")
             named.append("mesh")
         return advice, named
 
