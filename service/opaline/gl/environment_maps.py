@@ -51,7 +51,8 @@ class EnvironmentMaps:
         return found
 
     def _upload(self, name: str) -> EnvironmentMap:
-        radiance, directions, lights = split_bright(resolve_map(name, self.environments_dir, self.paths))
+        radiance, directions, lights = split_bright(
+            resolve_map(name, self.environments_dir, self.paths))
         height, width = radiance.shape[:2]
         # Rows flipped: the map's row 0 is the zenith, GL's row 0 is v = 0 (the nadir).
         # RGBA, the fourth channel unread: llvmpipe fetches 16-byte texels faster than

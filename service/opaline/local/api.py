@@ -7,9 +7,10 @@
 
 Each thread gets its own ``pipeline.LocalRenderer`` (a GL context is current
 on one thread only), made on first use and kept for the next call; ``close()``
-releases the calling thread's renderer, and a thread that ends releases its own. Invalid requests raise ``RequestError``
-(one line per field: name, value, allowed range); an unknown preset raises
-``presets.UnknownPreset``; a request over the cost budget ``request.CostError``.
+releases the calling thread's renderer, and a thread that ends releases its own.
+Invalid requests raise ``RequestError`` (one line per field: name, value, allowed
+range); an unknown preset raises ``presets.UnknownPreset``; a request over the cost
+budget ``request.CostError``.
 """
 
 from __future__ import annotations
